@@ -1,0 +1,304 @@
+//! `granflow bench dem`: the DEM throughput benchmark of `../shared/bench/README.md`, optionally run side by side
+//! with LIGGGHTS on its reference input in the same invocation, printing both throughputs, the physics of both
+//! (kinetic-energy history, final bed height) and the ratio.
+//!
+//! The problem is `scenarios/bench-settle.yaml` (compiled in). LIGGGHTS runs an exact copy of `in.settle` in a
+//! temporary directory with two thermo columns added (highest and mean particle height); nothing else changes.
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+use std::time::Instant;
+
+use crate::engine::Simulation;
+use crate::error::{Error, Result};
+use crate::scenario;
+
+pub const BENCH_SCENARIO: &str = include_str!("../scenarios/bench-settle.yaml");
+
+#[derive(Debug, Clone)]
+pub struct DemBenchOptions {
+    pub threads: usize,
+    pub steps: u64,
+    pub liggghts: bool,
+    pub liggghts_input: Option<PathBuf>,
+    pub liggghts_binary: PathBuf,
+}
+
+/// One sample of a run's physics: step, translational KE (J), highest and mean centre height (m).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PhysicsSample {
+    pub step: u64,
+    pub kinetic_energy_j: f64,
+    pub top_z_m: f64,
+    pub mean_z_m: f64,
+}
+
+#[derive(Debug, Clone)]
+pub struct RunFigures {
+    pub particles: usize,
+    pub steps: u64,
+    pub loop_time_s: f64,
+    pub samples: Vec<PhysicsSample>,
+}
+
+impl RunFigures {
+    pub fn particle_steps_per_s(&self) -> f64 {
+        self.particles as f64 * self.steps as f64 / self.loop_time_s
+    }
+}
+
+const SAMPLE_EVERY: u64 = 5000;
+
+fn sample(sim: &Simulation) -> PhysicsSample {
+    let p = &sim.particles;
+    let mut top = f64::NEG_INFINITY;
+    let mut sum = 0.0;
+    for x in &p.position_m {
+        top = top.max(x.z);
+        sum += x.z;
+    }
+    PhysicsSample {
+        step: sim.step,
+        kinetic_energy_j: p.translational_kinetic_energy_j(),
+        top_z_m: top,
+        mean_z_m: sum / p.len() as f64,
+    }
+}
+
+/// Peak resident memory of this process (VmHWM), bytes.
+fn peak_rss_bytes() -> Option<u64> {
+    let status = std::fs::read_to_string("/proc/self/status").ok()?;
+    let line = status.lines().find(|l| l.starts_with("VmHWM:"))?;
+    let kb: u64 = line.split_whitespace().nth(1)?.parse().ok()?;
+    Some(kb * 1024)
+}
+
+/// Runs granflow on the benchmark problem.
+pub fn run_granflow(threads: usize, steps: u64) -> Result<(RunFigures, Simulation)> {
+    let built = scenario::build(
+        scenario::parse(BENCH_SCENARIO, Path::new("scenarios/bench-settle.yaml"))?,
+        Path::new("scenarios/bench-settle.yaml"),
+    )?;
+    let mut sim = Simulation::new(built.config.clone(), built.particles, built.dt_s, built.rng, threads)?;
+    let mut samples = vec![sample(&sim)];
+    let start = Instant::now();
+    while sim.step < steps {
+        let chunk = (SAMPLE_EVERY - sim.step % SAMPLE_EVERY).min(steps - sim.step);
+        sim.run_steps(chunk)?;
+        if sim.step % SAMPLE_EVERY == 0 || sim.step == steps {
+            samples.push(sample(&sim));
+        }
+    }
+    let loop_time_s = start.elapsed().as_secs_f64();
+    Ok((
+        RunFigures {
+            particles: sim.particles.len(),
+            steps,
+            loop_time_s,
+            samples,
+        },
+        sim,
+    ))
+}
+
+/// Finds `../shared/bench/liggghts/in.settle` from the working directory or its ancestors.
+fn find_liggghts_input() -> Option<PathBuf> {
+    let mut dir = std::env::current_dir().ok()?;
+    loop {
+        for candidate in [
+            dir.join("shared/bench/liggghts/in.settle"),
+            dir.join("../shared/bench/liggghts/in.settle"),
+        ] {
+            if candidate.is_file() {
+                return Some(candidate);
+            }
+        }
+        if !dir.pop() {
+            return None;
+        }
+    }
+}
+
+/// Runs LIGGGHTS on a copy of the reference input with height columns added to its thermo output.
+pub fn run_liggghts(binary: &Path, input: &Path, steps: u64) -> Result<(RunFigures, Option<f64>)> {
+    let text = std::fs::read_to_string(input).map_err(|e| Error::io("read", input, e))?;
+    let mut modified = String::new();
+    let mut saw_thermo_style = false;
+    for line in text.lines() {
+        if line.trim_start().starts_with("thermo_style") {
+            saw_thermo_style = true;
+            modified.push_str("compute gf_ztop all reduce max z\ncompute gf_zmean all reduce ave z\n");
+            modified.push_str("thermo_style custom step atoms ke c_gf_ztop c_gf_zmean\n");
+        } else if line.trim_start().starts_with("run ") && steps != 20_000 {
+            modified.push_str(&format!("run {steps}\n"));
+        } else {
+            modified.push_str(line);
+            modified.push('\n');
+        }
+    }
+    if !saw_thermo_style {
+        return Err(Error::External(format!("{} has no thermo_style line to extend", input.display())));
+    }
+    let dir = tempfile::tempdir().map_err(|e| Error::io("create temporary directory", std::env::temp_dir(), e))?;
+    let copy = dir.path().join("in.settle");
+    std::fs::write(&copy, modified).map_err(|e| Error::io("write", &copy, e))?;
+    let output = Command::new(binary)
+        .arg("-in")
+        .arg(&copy)
+        .current_dir(dir.path())
+        .output()
+        .map_err(|e| Error::io("run", binary, e))?;
+    let stdout = String::from_utf8_lossy(&output.stdout);
+    if !output.status.success() {
+        return Err(Error::External(format!(
+            "{} failed ({}): {}",
+            binary.display(),
+            output.status,
+            stdout.lines().rev().take(5).collect::<Vec<_>>().join(" | ")
+        )));
+    }
+    parse_liggghts_log(&stdout)
+}
+
+/// Parses LIGGGHTS' thermo table and "Loop time of T on 1 procs for S steps with N atoms".
+pub fn parse_liggghts_log(log: &str) -> Result<(RunFigures, Option<f64>)> {
+    let mut samples = Vec::new();
+    let mut in_table = false;
+    let mut figures = None;
+    let mut memory_mb = None;
+    for line in log.lines() {
+        let t = line.trim();
+        if t.starts_with("Memory usage per processor") {
+            memory_mb = t.split('=').nth(1).and_then(|s| s.split_whitespace().next()).and_then(|s| s.parse().ok());
+        }
+        if t.starts_with("Step") {
+            in_table = true;
+            continue;
+        }
+        if t.starts_with("Loop time of") {
+            in_table = false;
+            let words: Vec<&str> = t.split_whitespace().collect();
+            let num = |k: usize| words.get(k).and_then(|w| w.trim_end_matches(',').parse::<f64>().ok());
+            if let (Some(time), Some(steps), Some(atoms)) = (num(3), num(8), num(11)) {
+                figures.get_or_insert((time, steps as u64, atoms as usize));
+            }
+            continue;
+        }
+        if in_table {
+            let cols: Vec<f64> = t.split_whitespace().filter_map(|w| w.parse().ok()).collect();
+            if cols.len() == 5 {
+                samples.push(PhysicsSample {
+                    step: cols[0] as u64,
+                    kinetic_energy_j: cols[2],
+                    top_z_m: cols[3],
+                    mean_z_m: cols[4],
+                });
+            } else {
+                in_table = false;
+            }
+        }
+    }
+    let (loop_time_s, steps, particles) =
+        figures.ok_or_else(|| Error::External("LIGGGHTS printed no 'Loop time of' line".into()))?;
+    Ok((
+        RunFigures {
+            particles,
+            steps,
+            loop_time_s,
+            samples,
+        },
+        memory_mb,
+    ))
+}
+
+fn rel(a: f64, b: f64) -> f64 {
+    if b == 0.0 { f64::NAN } else { (a - b) / b }
+}
+
+/// Runs the benchmark and prints its report; the last line is `ratio_vs_liggghts: <x>` when LIGGGHTS ran.
+pub fn bench_dem(opts: &DemBenchOptions) -> Result<()> {
+    let (ours, sim) = run_granflow(opts.threads, opts.steps)?;
+    let heap = sim.heap_bytes();
+    println!(
+        "granflow: {} particles, {} steps, {} thread(s): loop time {:.2} s, {:.4e} particle-steps/s, {} neighbour-list builds",
+        ours.particles,
+        ours.steps,
+        sim.threads(),
+        ours.loop_time_s,
+        ours.particle_steps_per_s(),
+        sim.neighbor_builds()
+    );
+    let t = sim.timers;
+    let total = (t.force + t.neighbor + t.integrate).as_secs_f64().max(1e-12);
+    println!(
+        "granflow: stages: force {:.1} %, neighbour {:.1} %, integrate {:.1} %",
+        100.0 * t.force.as_secs_f64() / total,
+        100.0 * t.neighbor.as_secs_f64() / total,
+        100.0 * t.integrate.as_secs_f64() / total
+    );
+    println!(
+        "granflow: memory: {:.0} bytes/particle in engine arrays; peak resident {:.1} MB for the whole process",
+        heap as f64 / ours.particles as f64,
+        peak_rss_bytes().map_or(f64::NAN, |b| b as f64 / 1e6)
+    );
+    if !opts.liggghts {
+        for s in &ours.samples {
+            println!(
+                "granflow: step {:>6} KE {:.5e} J, highest centre {:.5} m, mean centre {:.5} m",
+                s.step, s.kinetic_energy_j, s.top_z_m, s.mean_z_m
+            );
+        }
+        return Ok(());
+    }
+    let input = match &opts.liggghts_input {
+        Some(p) => p.clone(),
+        None => find_liggghts_input().ok_or_else(|| {
+            Error::External("cannot find ../shared/bench/liggghts/in.settle; pass --liggghts-input".into())
+        })?,
+    };
+    let (theirs, memory_mb) = run_liggghts(&opts.liggghts_binary, &input, opts.steps)?;
+    println!(
+        "liggghts: {} particles, {} steps, 1 process: loop time {:.2} s, {:.4e} particle-steps/s{}",
+        theirs.particles,
+        theirs.steps,
+        theirs.loop_time_s,
+        theirs.particle_steps_per_s(),
+        memory_mb.map_or(String::new(), |m| format!(", memory {m:.2} MB ({:.0} bytes/particle, its own estimate)", m * 1.048576e6 / theirs.particles as f64))
+    );
+    println!("physics:   step      KE granflow (J)  KE liggghts (J)  diff     top z granflow  top z liggghts  mean z granflow  mean z liggghts  diff");
+    for s in &ours.samples {
+        if let Some(l) = theirs.samples.iter().find(|l| l.step == s.step) {
+            println!(
+                "physics: {:>6}  {:>15.5e}  {:>15.5e}  {:>+7.2} %  {:>14.5}  {:>14.5}  {:>15.5}  {:>15.5}  {:>+6.2} %",
+                s.step,
+                s.kinetic_energy_j,
+                l.kinetic_energy_j,
+                100.0 * rel(s.kinetic_energy_j, l.kinetic_energy_j),
+                s.top_z_m,
+                l.top_z_m,
+                s.mean_z_m,
+                l.mean_z_m,
+                100.0 * rel(s.mean_z_m, l.mean_z_m)
+            );
+        }
+    }
+    println!("ratio_vs_liggghts: {:.3}", ours.particle_steps_per_s() / theirs.particle_steps_per_s());
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn parses_a_liggghts_log() {
+        let log = "Memory usage per processor = 18.4905 Mbytes\n    Step    Atoms         KinEng     c_gf_ztop c_gf_zmean\n       0    29160              0 0.288 0.1 \n    5000    29160      0.0621384 0.2 0.05\nLoop time of 110.872 on 1 procs for 5000 steps with 29160 atoms, finish time Sun\n";
+        let (f, mem) = parse_liggghts_log(log).expect("parses");
+        assert_eq!(f.particles, 29160);
+        assert_eq!(f.steps, 5000);
+        assert!((f.loop_time_s - 110.872).abs() < 1e-9);
+        assert_eq!(f.samples.len(), 2);
+        assert_eq!(f.samples[1].kinetic_energy_j, 0.0621384);
+        assert_eq!(mem, Some(18.4905));
+    }
+}

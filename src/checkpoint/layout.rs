@@ -1,0 +1,657 @@
+//! What a checkpoint file contains: the dataset table (names, element types, shapes, units, checksum order), the
+//! flat arrays that mirror it, their conversion from and to a [`SimState`], their consistency checks, the content
+//! checksum, and the seal (the file checksum kept in the HDF5 userblock).
+//!
+//! The table is written once, in the `datasets!` invocation below, and everything else (writing, reading, shape
+//! checks, checksum) walks it through [`Arrays::visit`] / [`Arrays::visit_mut`], so the order of the checksum is
+//! the order of that table by construction. `schemas/checkpoint.md` documents the same table; keep them in step.
+//! HDF5 itself is handled in `super` (the parent module), not here.
+//!
+//! The seal exists because libhdf5 (1.10) trusts its own metadata: a flipped bit in an object header can crash the
+//! process (SIGSEGV) instead of returning an error. So the writer hashes every byte after the userblock once the
+//! HDF5 file is closed and records the length and hash in the userblock, and the reader checks both before
+//! libhdf5 sees the file. A damaged or truncated file is thus rejected in plain Rust.
+
+use std::collections::HashMap;
+use std::fs::{File, OpenOptions};
+use std::io::{Read, Seek, SeekFrom, Write};
+use std::path::Path;
+
+use xxhash_rust::xxh3::Xxh3Default;
+
+use super::{CheckpointError, CheckpointMeta};
+use crate::engine::Vec3;
+use crate::engine::contacts::{ContactStore, WallId};
+use crate::engine::models::ContactHistory;
+use crate::engine::particles::{ParticleId, Particles, SpeciesId};
+use crate::engine::state::{RngState, SimState};
+
+/// Value of the root attribute `format`.
+pub(crate) const FORMAT_NAME: &str = "granflow-checkpoint";
+
+/// Which count the first dimension of a dataset follows.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub(crate) enum Rows {
+    /// N, the number of particles.
+    Particles,
+    /// The number of particle–particle contacts.
+    PairContacts,
+    /// The number of particle–wall contacts.
+    WallContacts,
+    /// The number of walls.
+    Walls,
+    /// A fixed length (the RNG seed).
+    Fixed(usize),
+    /// A scalar (rank-0) dataset.
+    Scalar,
+}
+
+/// One dataset of the layout.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) struct DatasetSpec {
+    /// Path below the root, without the leading slash, e.g. `particles/position_m`.
+    pub path: &'static str,
+    pub rows: Rows,
+    /// 1 for a one-dimensional dataset, 3 for a rows × 3 dataset of vectors.
+    pub width: usize,
+    /// Value of the dataset's `units` attribute.
+    pub units: &'static str,
+    /// Element type, as named in `schemas/checkpoint.md`.
+    pub dtype: &'static str,
+}
+
+impl DatasetSpec {
+    /// The HDF5 shape of this dataset when it holds `len` elements.
+    pub(crate) fn shape(&self, len: usize) -> Vec<usize> {
+        match (self.rows, self.width) {
+            (Rows::Scalar, _) => Vec::new(),
+            (_, 1) => vec![len],
+            (_, w) => vec![len / w, w],
+        }
+    }
+}
+
+/// An element type of a checkpoint dataset, with its little-endian encoding for the checksum.
+pub(crate) trait Element: hdf5::H5Type + Copy + Default + 'static {
+    /// Type name used in the documentation and in error messages.
+    const NAME: &'static str;
+    /// Appends the little-endian bytes of `self` to `out`.
+    fn put_le(self, out: &mut Vec<u8>);
+}
+
+macro_rules! element {
+    ($($ty:ty),*) => {$(
+        impl Element for $ty {
+            const NAME: &'static str = stringify!($ty);
+            #[inline]
+            fn put_le(self, out: &mut Vec<u8>) {
+                out.extend_from_slice(&self.to_le_bytes());
+            }
+        }
+    )*};
+}
+element!(u8, u16, u32, u64, f64);
+
+/// Walks the datasets of [`Arrays`] in table order, read-only.
+pub(crate) trait Visitor {
+    type Error;
+    fn visit<T: Element>(&mut self, spec: &DatasetSpec, data: &[T]) -> Result<(), Self::Error>;
+}
+
+/// Walks the datasets of [`Arrays`] in table order, filling them (the reader).
+pub(crate) trait VisitorMut {
+    type Error;
+    fn visit<T: Element>(
+        &mut self,
+        spec: &DatasetSpec,
+        data: &mut Vec<T>,
+    ) -> Result<(), Self::Error>;
+}
+
+/// Declares the dataset table: the [`Arrays`] struct (one flat, row-major `Vec` per dataset), [`DATASETS`], and
+/// the two visitors. The order of the entries is the checksum order.
+macro_rules! datasets {
+    ($( $field:ident : $ty:ty => $path:literal, $rows:expr, $width:literal, $units:expr; )*) => {
+        /// The datasets of a checkpoint as flat row-major arrays, one field per dataset.
+        #[derive(Debug, Clone, Default, PartialEq)]
+        pub(crate) struct Arrays {
+            $( pub $field: Vec<$ty>, )*
+        }
+
+        /// Every dataset of the layout, in checksum order.
+        pub(crate) const DATASETS: &[DatasetSpec] = &[$(
+            DatasetSpec {
+                path: $path,
+                rows: $rows,
+                width: $width,
+                units: $units,
+                dtype: <$ty as Element>::NAME,
+            },
+        )*];
+
+        impl Arrays {
+            /// Calls `v` on every dataset in table order.
+            pub(crate) fn visit<V: Visitor>(&self, v: &mut V) -> Result<(), V::Error> {
+                let mut specs = DATASETS.iter();
+                $(
+                    let spec = specs.next().expect("DATASETS has one entry per field");
+                    v.visit(spec, &self.$field)?;
+                )*
+                Ok(())
+            }
+
+            /// Calls `v` on every dataset in table order, letting it fill the arrays.
+            pub(crate) fn visit_mut<V: VisitorMut>(&mut self, v: &mut V) -> Result<(), V::Error> {
+                let mut specs = DATASETS.iter();
+                $(
+                    let spec = specs.next().expect("DATASETS has one entry per field");
+                    v.visit(spec, &mut self.$field)?;
+                )*
+                Ok(())
+            }
+        }
+    };
+}
+
+const TANGENTIAL_UNITS: &str =
+    "m (linear_spring_coulomb, mindlin: displacement) or N (walton_braun: force)";
+
+datasets! {
+    particle_id: u32 => "particles/id", Rows::Particles, 1, "1";
+    particle_species: u16 => "particles/species", Rows::Particles, 1, "1";
+    radius_m: f64 => "particles/radius_m", Rows::Particles, 1, "m";
+    mass_kg: f64 => "particles/mass_kg", Rows::Particles, 1, "kg";
+    inertia_kg_m2: f64 => "particles/inertia_kg_m2", Rows::Particles, 1, "kg m2";
+    position_m: f64 => "particles/position_m", Rows::Particles, 3, "m";
+    velocity_m_per_s: f64 => "particles/velocity_m_per_s", Rows::Particles, 3, "m/s";
+    angular_velocity_rad_per_s: f64 => "particles/angular_velocity_rad_per_s", Rows::Particles, 3, "rad/s";
+    force_n: f64 => "particles/force_n", Rows::Particles, 3, "N";
+    torque_n_m: f64 => "particles/torque_n_m", Rows::Particles, 3, "N m";
+
+    pair_i: u32 => "contacts/pairs/i", Rows::PairContacts, 1, "1";
+    pair_j: u32 => "contacts/pairs/j", Rows::PairContacts, 1, "1";
+    pair_active: u8 => "contacts/pairs/active", Rows::PairContacts, 1, "1";
+    pair_yielded: u8 => "contacts/pairs/yielded", Rows::PairContacts, 1, "1";
+    pair_tangential: f64 => "contacts/pairs/tangential", Rows::PairContacts, 3, TANGENTIAL_UNITS;
+    pair_reversal_force_n: f64 => "contacts/pairs/reversal_force_n", Rows::PairContacts, 3, "N";
+    pair_increment_direction: f64 => "contacts/pairs/increment_direction", Rows::PairContacts, 3, "1";
+    pair_max_overlap_m: f64 => "contacts/pairs/max_overlap_m", Rows::PairContacts, 1, "m";
+    pair_max_normal_force_n: f64 => "contacts/pairs/max_normal_force_n", Rows::PairContacts, 1, "N";
+
+    wall_i: u32 => "contacts/walls/i", Rows::WallContacts, 1, "1";
+    wall_wall: u16 => "contacts/walls/wall", Rows::WallContacts, 1, "1";
+    wall_active: u8 => "contacts/walls/active", Rows::WallContacts, 1, "1";
+    wall_yielded: u8 => "contacts/walls/yielded", Rows::WallContacts, 1, "1";
+    wall_tangential: f64 => "contacts/walls/tangential", Rows::WallContacts, 3, TANGENTIAL_UNITS;
+    wall_reversal_force_n: f64 => "contacts/walls/reversal_force_n", Rows::WallContacts, 3, "N";
+    wall_increment_direction: f64 => "contacts/walls/increment_direction", Rows::WallContacts, 3, "1";
+    wall_max_overlap_m: f64 => "contacts/walls/max_overlap_m", Rows::WallContacts, 1, "m";
+    wall_max_normal_force_n: f64 => "contacts/walls/max_normal_force_n", Rows::WallContacts, 1, "N";
+
+    wall_angle_rad: f64 => "walls/angle_rad", Rows::Walls, 1, "rad";
+
+    rng_seed: u8 => "rng/seed", Rows::Fixed(32), 1, "1";
+    rng_stream: u64 => "rng/stream", Rows::Scalar, 1, "1";
+    rng_word_pos_hi: u64 => "rng/word_pos_hi", Rows::Scalar, 1, "1";
+    rng_word_pos_lo: u64 => "rng/word_pos_lo", Rows::Scalar, 1, "1";
+}
+
+/// Groups to create before the datasets, parents first.
+pub(crate) const GROUPS: &[&str] = &[
+    "particles",
+    "contacts",
+    "contacts/pairs",
+    "contacts/walls",
+    "walls",
+    "rng",
+];
+
+/// The scalar part of a checkpoint: the root attributes other than `format` and the checksum.
+#[derive(Debug, Clone, PartialEq)]
+pub(crate) struct Header<'a> {
+    pub format_version: u32,
+    pub step: u64,
+    pub time_s: f64,
+    pub dt_s: f64,
+    pub meta: &'a CheckpointMeta,
+}
+
+fn flatten(v: &[Vec3]) -> Vec<f64> {
+    v.iter().flat_map(|x| [x.x, x.y, x.z]).collect()
+}
+
+fn unflatten(v: &[f64]) -> Vec<Vec3> {
+    v.chunks_exact(3)
+        .map(|c| Vec3::new(c[0], c[1], c[2]))
+        .collect()
+}
+
+/// The history columns of one contact table, filled by [`HistoryColumns::push`].
+#[derive(Default)]
+struct HistoryColumns {
+    active: Vec<u8>,
+    yielded: Vec<u8>,
+    tangential: Vec<f64>,
+    reversal_force_n: Vec<f64>,
+    increment_direction: Vec<f64>,
+    max_overlap_m: Vec<f64>,
+    max_normal_force_n: Vec<f64>,
+}
+
+impl HistoryColumns {
+    fn push(&mut self, h: &ContactHistory) {
+        self.active.push(u8::from(h.active));
+        self.yielded.push(u8::from(h.yielded));
+        self.tangential
+            .extend_from_slice(&[h.tangential.x, h.tangential.y, h.tangential.z]);
+        self.reversal_force_n.extend_from_slice(&[
+            h.reversal_force_n.x,
+            h.reversal_force_n.y,
+            h.reversal_force_n.z,
+        ]);
+        self.increment_direction.extend_from_slice(&[
+            h.increment_direction.x,
+            h.increment_direction.y,
+            h.increment_direction.z,
+        ]);
+        self.max_overlap_m.push(h.max_overlap_m);
+        self.max_normal_force_n.push(h.max_normal_force_n);
+    }
+}
+
+/// The history of row `k` of a contact table. The arrays must have passed [`Arrays::check`].
+#[allow(clippy::too_many_arguments)]
+fn history_at(
+    k: usize,
+    active: &[u8],
+    yielded: &[u8],
+    tangential: &[f64],
+    reversal: &[f64],
+    direction: &[f64],
+    max_overlap: &[f64],
+    max_force: &[f64],
+) -> ContactHistory {
+    let v = |a: &[f64]| Vec3::new(a[3 * k], a[3 * k + 1], a[3 * k + 2]);
+    ContactHistory {
+        active: active[k] != 0,
+        yielded: yielded[k] != 0,
+        tangential: v(tangential),
+        reversal_force_n: v(reversal),
+        increment_direction: v(direction),
+        max_overlap_m: max_overlap[k],
+        max_normal_force_n: max_force[k],
+    }
+}
+
+impl Arrays {
+    /// The datasets of `state`. Call [`Arrays::check`] on the result before writing it.
+    pub(crate) fn from_state(state: &SimState) -> Arrays {
+        let p = &state.particles;
+        let mut pairs = HistoryColumns::default();
+        for (_, _, h) in &state.contacts.pairs {
+            pairs.push(h);
+        }
+        let mut walls = HistoryColumns::default();
+        for (_, _, h) in &state.contacts.walls {
+            walls.push(h);
+        }
+        Arrays {
+            particle_id: p.id.iter().map(|id| id.0).collect(),
+            particle_species: p.species.iter().map(|s| s.0).collect(),
+            radius_m: p.radius_m.clone(),
+            mass_kg: p.mass_kg.clone(),
+            inertia_kg_m2: p.inertia_kg_m2.clone(),
+            position_m: flatten(&p.position_m),
+            velocity_m_per_s: flatten(&p.velocity_m_per_s),
+            angular_velocity_rad_per_s: flatten(&p.angular_velocity_rad_per_s),
+            force_n: flatten(&p.force_n),
+            torque_n_m: flatten(&p.torque_n_m),
+
+            pair_i: state.contacts.pairs.iter().map(|(i, _, _)| i.0).collect(),
+            pair_j: state.contacts.pairs.iter().map(|(_, j, _)| j.0).collect(),
+            pair_active: pairs.active,
+            pair_yielded: pairs.yielded,
+            pair_tangential: pairs.tangential,
+            pair_reversal_force_n: pairs.reversal_force_n,
+            pair_increment_direction: pairs.increment_direction,
+            pair_max_overlap_m: pairs.max_overlap_m,
+            pair_max_normal_force_n: pairs.max_normal_force_n,
+
+            wall_i: state.contacts.walls.iter().map(|(i, _, _)| i.0).collect(),
+            wall_wall: state.contacts.walls.iter().map(|(_, w, _)| w.0).collect(),
+            wall_active: walls.active,
+            wall_yielded: walls.yielded,
+            wall_tangential: walls.tangential,
+            wall_reversal_force_n: walls.reversal_force_n,
+            wall_increment_direction: walls.increment_direction,
+            wall_max_overlap_m: walls.max_overlap_m,
+            wall_max_normal_force_n: walls.max_normal_force_n,
+
+            wall_angle_rad: state.wall_angle_rad.clone(),
+
+            rng_seed: state.rng.seed.to_vec(),
+            rng_stream: vec![state.rng.stream],
+            rng_word_pos_hi: vec![(state.rng.word_pos >> 64) as u64],
+            rng_word_pos_lo: vec![state.rng.word_pos as u64],
+        }
+    }
+
+    /// Checks that the arrays describe a consistent state: every dataset has the shape its [`Rows`] demand (all
+    /// particle datasets the same number of rows, and so on), flags are 0 or 1, and every contact refers to an
+    /// existing particle and wall. Returns the first problem found.
+    pub(crate) fn check(&self) -> Result<(), String> {
+        let mut shapes = ShapeCheck::default();
+        self.visit(&mut shapes)?;
+        let n = self.particle_id.len();
+        let n_walls = self.wall_angle_rad.len();
+        let flags = [
+            ("contacts/pairs/active", &self.pair_active),
+            ("contacts/pairs/yielded", &self.pair_yielded),
+            ("contacts/walls/active", &self.wall_active),
+            ("contacts/walls/yielded", &self.wall_yielded),
+        ];
+        for (path, values) in flags {
+            if let Some(k) = values.iter().position(|&v| v > 1) {
+                return Err(format!("/{path}[{k}] is {}, expected 0 or 1", values[k]));
+            }
+        }
+        let particles = [
+            ("contacts/pairs/i", &self.pair_i),
+            ("contacts/pairs/j", &self.pair_j),
+            ("contacts/walls/i", &self.wall_i),
+        ];
+        for (path, values) in particles {
+            if let Some(k) = values.iter().position(|&v| v as usize >= n) {
+                return Err(format!(
+                    "/{path}[{k}] = {} is not a particle (there are {n})",
+                    values[k]
+                ));
+            }
+        }
+        if let Some(k) = self.wall_wall.iter().position(|&w| w as usize >= n_walls) {
+            return Err(format!(
+                "/contacts/walls/wall[{k}] = {} is not a wall (there are {n_walls})",
+                self.wall_wall[k]
+            ));
+        }
+        Ok(())
+    }
+
+    /// The state these arrays describe. The arrays must have passed [`Arrays::check`].
+    pub(crate) fn into_state(self, header: &Header<'_>) -> SimState {
+        let particles = Particles {
+            id: self.particle_id.iter().map(|&i| ParticleId(i)).collect(),
+            species: self
+                .particle_species
+                .iter()
+                .map(|&s| SpeciesId(s))
+                .collect(),
+            radius_m: self.radius_m,
+            mass_kg: self.mass_kg,
+            inertia_kg_m2: self.inertia_kg_m2,
+            position_m: unflatten(&self.position_m),
+            velocity_m_per_s: unflatten(&self.velocity_m_per_s),
+            angular_velocity_rad_per_s: unflatten(&self.angular_velocity_rad_per_s),
+            force_n: unflatten(&self.force_n),
+            torque_n_m: unflatten(&self.torque_n_m),
+        };
+        let pairs = (0..self.pair_i.len())
+            .map(|k| {
+                let h = history_at(
+                    k,
+                    &self.pair_active,
+                    &self.pair_yielded,
+                    &self.pair_tangential,
+                    &self.pair_reversal_force_n,
+                    &self.pair_increment_direction,
+                    &self.pair_max_overlap_m,
+                    &self.pair_max_normal_force_n,
+                );
+                (ParticleId(self.pair_i[k]), ParticleId(self.pair_j[k]), h)
+            })
+            .collect();
+        let walls = (0..self.wall_i.len())
+            .map(|k| {
+                let h = history_at(
+                    k,
+                    &self.wall_active,
+                    &self.wall_yielded,
+                    &self.wall_tangential,
+                    &self.wall_reversal_force_n,
+                    &self.wall_increment_direction,
+                    &self.wall_max_overlap_m,
+                    &self.wall_max_normal_force_n,
+                );
+                (ParticleId(self.wall_i[k]), WallId(self.wall_wall[k]), h)
+            })
+            .collect();
+        let mut seed = [0u8; 32];
+        seed.copy_from_slice(&self.rng_seed);
+        let word_pos =
+            (u128::from(self.rng_word_pos_hi[0]) << 64) | u128::from(self.rng_word_pos_lo[0]);
+        SimState {
+            step: header.step,
+            time_s: header.time_s,
+            dt_s: header.dt_s,
+            particles,
+            wall_angle_rad: self.wall_angle_rad,
+            contacts: ContactStore { pairs, walls },
+            rng: RngState {
+                seed,
+                stream: self.rng_stream[0],
+                word_pos,
+            },
+        }
+    }
+}
+
+/// Checks every dataset's length against its [`Rows`]: the first dataset of each kind fixes the count.
+#[derive(Default)]
+struct ShapeCheck {
+    rows: HashMap<Rows, (usize, &'static str)>,
+}
+
+impl Visitor for ShapeCheck {
+    type Error = String;
+
+    fn visit<T: Element>(&mut self, spec: &DatasetSpec, data: &[T]) -> Result<(), String> {
+        let len = data.len();
+        match spec.rows {
+            Rows::Scalar if len != 1 => Err(format!(
+                "/{} must be a scalar, has {len} elements",
+                spec.path
+            )),
+            Rows::Fixed(n) if len != n * spec.width => Err(format!(
+                "/{} must have {} elements, has {len}",
+                spec.path,
+                n * spec.width
+            )),
+            Rows::Scalar | Rows::Fixed(_) => Ok(()),
+            _ if !len.is_multiple_of(spec.width) => Err(format!(
+                "/{} has {len} elements, not a multiple of {}",
+                spec.path, spec.width
+            )),
+            kind => {
+                let rows = len / spec.width;
+                let (expected, first) = *self.rows.entry(kind).or_insert((rows, spec.path));
+                if rows == expected {
+                    Ok(())
+                } else {
+                    Err(format!(
+                        "/{} has {rows} rows but /{first} has {expected}",
+                        spec.path
+                    ))
+                }
+            }
+        }
+    }
+}
+
+/// Feeds the checksum: the byte stream documented in `schemas/checkpoint.md`.
+struct Hasher {
+    h: Xxh3Default,
+    buf: Vec<u8>,
+}
+
+impl Hasher {
+    fn u32(&mut self, v: u32) {
+        self.h.update(&v.to_le_bytes());
+    }
+
+    fn u64(&mut self, v: u64) {
+        self.h.update(&v.to_le_bytes());
+    }
+
+    fn str(&mut self, s: &str) {
+        self.u64(s.len() as u64);
+        self.h.update(s.as_bytes());
+    }
+
+    fn strs(&mut self, v: &[String]) {
+        self.u64(v.len() as u64);
+        for s in v {
+            self.str(s);
+        }
+    }
+}
+
+impl Visitor for Hasher {
+    type Error = std::convert::Infallible;
+
+    fn visit<T: Element>(&mut self, spec: &DatasetSpec, data: &[T]) -> Result<(), Self::Error> {
+        self.str(spec.path);
+        let shape = spec.shape(data.len());
+        self.u64(shape.len() as u64);
+        for d in shape {
+            self.u64(d as u64);
+        }
+        for chunk in data.chunks(4096) {
+            self.buf.clear();
+            for &x in chunk {
+                x.put_le(&mut self.buf);
+            }
+            self.h.update(&self.buf);
+        }
+        Ok(())
+    }
+}
+
+/// The xxh3-64 checksum of a checkpoint: the header fields, then every dataset in table order.
+pub(crate) fn checksum(header: &Header<'_>, arrays: &Arrays) -> u64 {
+    let mut h = Hasher {
+        h: Xxh3Default::new(),
+        buf: Vec::with_capacity(4096 * 8),
+    };
+    h.str(FORMAT_NAME);
+    h.u32(header.format_version);
+    h.str(&header.meta.engine_version);
+    h.u64(header.step);
+    h.u64(header.time_s.to_bits());
+    h.u64(header.dt_s.to_bits());
+    h.strs(&header.meta.model_names);
+    h.strs(&header.meta.wall_names);
+    h.str(&header.meta.scenario_json);
+    match arrays.visit(&mut h) {
+        Ok(()) => {}
+        Err(never) => match never {},
+    }
+    h.h.digest()
+}
+
+/// Size of the HDF5 userblock at the start of every checkpoint, which holds the seal.
+pub(crate) const SEAL_BYTES: u64 = 512;
+const SEAL_MAGIC: &str = "granflow-checkpoint seal v1\n";
+
+/// The userblock: magic line, `hdf5_bytes=<decimal>`, `file_xxh3_64=0x<16 hex digits>`, zero padding.
+fn seal_block(hdf5_bytes: u64, hash: u64) -> Vec<u8> {
+    let mut block =
+        format!("{SEAL_MAGIC}hdf5_bytes={hdf5_bytes}\nfile_xxh3_64={hash:#018x}\n").into_bytes();
+    block.resize(SEAL_BYTES as usize, 0);
+    block
+}
+
+/// The length and hash recorded in a seal block, given the bytes after the magic line.
+fn parse_seal(rest: &[u8]) -> Option<(u64, u64)> {
+    let text = std::str::from_utf8(rest.split(|&b| b == 0).next()?).ok()?;
+    let mut lines = text.lines();
+    let len = lines.next()?.strip_prefix("hdf5_bytes=")?.parse().ok()?;
+    let hash = u64::from_str_radix(lines.next()?.strip_prefix("file_xxh3_64=0x")?, 16).ok()?;
+    Some((len, hash))
+}
+
+/// The xxh3-64 of everything from the current position of `file` to its end, and the number of bytes hashed.
+fn hash_rest(file: &mut File) -> std::io::Result<(u64, u64)> {
+    let mut hasher = Xxh3Default::new();
+    let mut buf = vec![0u8; 1 << 20];
+    let mut len = 0u64;
+    loop {
+        match file.read(&mut buf) {
+            Ok(0) => return Ok((hasher.digest(), len)),
+            Ok(k) => {
+                hasher.update(&buf[..k]);
+                len += k as u64;
+            }
+            Err(e) if e.kind() == std::io::ErrorKind::Interrupted => {}
+            Err(e) => return Err(e),
+        }
+    }
+}
+
+/// Seals the closed HDF5 file at `path` (created with a [`SEAL_BYTES`] userblock): hashes everything after the
+/// userblock, writes the seal into it and fsyncs the file.
+pub(crate) fn seal(path: &Path) -> Result<(), CheckpointError> {
+    let io = |e: std::io::Error| CheckpointError::io(path, "sealing the file", e);
+    let mut file = OpenOptions::new()
+        .read(true)
+        .write(true)
+        .open(path)
+        .map_err(io)?;
+    file.seek(SeekFrom::Start(SEAL_BYTES)).map_err(io)?;
+    let (hash, len) = hash_rest(&mut file).map_err(io)?;
+    file.seek(SeekFrom::Start(0)).map_err(io)?;
+    file.write_all(&seal_block(len, hash)).map_err(io)?;
+    file.sync_all().map_err(io)
+}
+
+/// Checks the seal of the file at `path`: a well-formed seal block, the recorded length and the recorded hash.
+pub(crate) fn verify_seal(path: &Path) -> Result<(), CheckpointError> {
+    let io = |e: std::io::Error| CheckpointError::io(path, "reading the file", e);
+    let corrupt = |reason: String| CheckpointError::corrupt(path, reason);
+    let mut file = File::open(path).map_err(io)?;
+    let len = file.metadata().map_err(io)?.len();
+    if len < SEAL_BYTES {
+        return Err(corrupt(format!(
+            "truncated ({len} bytes, shorter than the {SEAL_BYTES}-byte seal block)"
+        )));
+    }
+    let mut block = vec![0u8; SEAL_BYTES as usize];
+    file.read_exact(&mut block).map_err(io)?;
+    let Some(rest) = block.strip_prefix(SEAL_MAGIC.as_bytes()) else {
+        return Err(corrupt(
+            "no checkpoint seal at the start of the file (not a granflow checkpoint, or rewritten by another tool)"
+                .to_string(),
+        ));
+    };
+    let (hdf5_bytes, stored) = parse_seal(rest)
+        .filter(|&(n, h)| seal_block(n, h) == block)
+        .ok_or_else(|| corrupt("the seal block is damaged".to_string()))?;
+    let expected = SEAL_BYTES.saturating_add(hdf5_bytes);
+    if len < expected {
+        return Err(corrupt(format!(
+            "truncated ({len} bytes, {expected} written)"
+        )));
+    }
+    if len > expected {
+        return Err(corrupt(format!(
+            "{} bytes longer than the {expected} written",
+            len - expected
+        )));
+    }
+    let (computed, _) = hash_rest(&mut file).map_err(io)?;
+    if computed != stored {
+        return Err(corrupt(format!(
+            "file checksum mismatch (stored {stored:#018x}, computed {computed:#018x})"
+        )));
+    }
+    Ok(())
+}

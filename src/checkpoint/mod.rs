@@ -1,0 +1,1243 @@
+//! HDF5 checkpoints: writing a [`SimState`] with its [`CheckpointMeta`] to one self-describing file, reading it
+//! back bit for bit, and keeping a rotating series of them per run ([`CheckpointSeries`]).
+//!
+//! A checkpoint is written atomically (temporary file, fsync, rename, fsync of the directory). It carries two
+//! checksums: an xxh3-64 over its content (attribute `checksum_xxh3_64`), and a seal in the HDF5 userblock holding
+//! the length and xxh3-64 of the file bytes, checked before libhdf5 parses the file. A reader therefore gets exactly
+//! the state that was written or a [`CheckpointError`] naming the file; truncated, bit-flipped or foreign files are
+//! errors, never panics or crashes. The layout (names, element types, units, checksum order, seal) is documented in
+//! `schemas/checkpoint.md` and defined in [`layout`]. What does *not* live here: deciding when to checkpoint,
+//! checking that a restored state matches the scenario being resumed (the caller compares [`CheckpointMeta`]), and
+//! rebuilding the engine from a state (`engine::Simulation::restore`).
+
+mod error;
+mod layout;
+mod series;
+
+use std::ffi::OsString;
+use std::path::{Path, PathBuf};
+
+use hdf5::types::VarLenUnicode;
+use hdf5::{Datatype, H5Type, Location};
+
+pub use error::CheckpointError;
+use layout::{
+    Arrays, DatasetSpec, Element, FORMAT_NAME, GROUPS, Header, Rows, SEAL_BYTES, Visitor,
+    VisitorMut, checksum, seal, verify_seal,
+};
+pub use series::{CheckpointSeries, LoadedCheckpoint};
+
+use crate::engine::SimState;
+
+/// Version of the file layout. Bump it whenever a name, type, shape or the checksum definition changes; readers
+/// reject any other version with [`CheckpointError::Version`].
+pub const CHECKPOINT_FORMAT_VERSION: u32 = 1;
+
+/// Metadata stored beside the state.
+#[derive(Debug, Clone, PartialEq)]
+pub struct CheckpointMeta {
+    /// Version of the engine that wrote the file, e.g. `env!("CARGO_PKG_VERSION")`.
+    pub engine_version: String,
+    /// Contact-law slot names (normal, tangential, rolling), e.g. `["thornton", "walton_braun", "none"]`.
+    pub model_names: Vec<String>,
+    /// Names of the scenario's walls, in wall-id order.
+    pub wall_names: Vec<String>,
+    /// The fully resolved scenario, so that a restore can check it matches.
+    pub scenario_json: String,
+}
+
+/// The temporary file a checkpoint is written to before being renamed over `path`: `<path>.tmp`.
+fn tmp_path(path: &Path) -> PathBuf {
+    let mut s = OsString::from(path.as_os_str());
+    s.push(".tmp");
+    PathBuf::from(s)
+}
+
+/// Writes `state` and `meta` to `path` atomically: to `<path>.tmp`, flush and close, seal (file checksum in the
+/// userblock) and fsync the file, rename it over `path`, fsync the directory. On failure the temporary file is
+/// removed and an existing `path` is left untouched.
+pub fn write_checkpoint(
+    path: &Path,
+    state: &SimState,
+    meta: &CheckpointMeta,
+) -> Result<(), CheckpointError> {
+    let invalid = |reason: String| CheckpointError::InvalidState {
+        path: path.to_path_buf(),
+        reason,
+    };
+    let arrays = Arrays::from_state(state);
+    arrays.check().map_err(invalid)?;
+    let strings = [
+        ("engine_version", &meta.engine_version),
+        ("scenario_json", &meta.scenario_json),
+    ]
+    .into_iter()
+    .chain(meta.model_names.iter().map(|s| ("model_names", s)))
+    .chain(meta.wall_names.iter().map(|s| ("wall_names", s)));
+    for (name, s) in strings {
+        if s.contains('\0') {
+            return Err(invalid(format!("{name} contains a NUL character")));
+        }
+    }
+    let header = Header {
+        format_version: CHECKPOINT_FORMAT_VERSION,
+        step: state.step,
+        time_s: state.time_s,
+        dt_s: state.dt_s,
+        meta,
+    };
+    let sum = checksum(&header, &arrays);
+
+    let tmp = tmp_path(path);
+    let result = write_hdf5(&tmp, &header, &arrays, sum).and_then(|()| commit(&tmp, path));
+    if result.is_err() {
+        // Best effort: the error being returned is the one worth reporting.
+        let _ = std::fs::remove_file(&tmp);
+    }
+    result
+}
+
+/// Seals and fsyncs `tmp`, renames it over `path` and fsyncs the directory.
+fn commit(tmp: &Path, path: &Path) -> Result<(), CheckpointError> {
+    seal(tmp)?;
+    std::fs::rename(tmp, path)
+        .map_err(|e| CheckpointError::io(path, "renaming the temporary file into place", e))?;
+    let dir = match path.parent() {
+        Some(d) if !d.as_os_str().is_empty() => d,
+        _ => Path::new("."),
+    };
+    std::fs::File::open(dir)
+        .and_then(|d| d.sync_all())
+        .map_err(|e| CheckpointError::io(path, "syncing the directory", e))
+}
+
+/// Creates the HDF5 file `tmp` with the whole checkpoint, then flushes and closes it.
+fn write_hdf5(
+    tmp: &Path,
+    header: &Header<'_>,
+    arrays: &Arrays,
+    sum: u64,
+) -> Result<(), CheckpointError> {
+    let err = |context: &'static str| move |e: hdf5::Error| CheckpointError::hdf5(tmp, context, e);
+    let file = hdf5::File::with_options()
+        .with_fcpl(|p| p.userblock(SEAL_BYTES))
+        .create(tmp)
+        .map_err(err("creating the file"))?;
+    // Every handle opened below is dropped before `close`, which otherwise leaves the file open (weak close).
+    write_contents(&file, tmp, header, arrays, sum)?;
+    file.flush().map_err(err("flushing the file"))?;
+    file.close().map_err(err("closing the file"))
+}
+
+fn write_contents(
+    file: &hdf5::File,
+    tmp: &Path,
+    header: &Header<'_>,
+    arrays: &Arrays,
+    sum: u64,
+) -> Result<(), CheckpointError> {
+    let attr_err = |name: &str| {
+        let context = format!("writing attribute {name}");
+        move |e: hdf5::Error| CheckpointError::hdf5(tmp, context, e)
+    };
+    let meta = header.meta;
+    put_str_attr(file, "format", FORMAT_NAME).map_err(attr_err("format"))?;
+    put_scalar_attr(file, "format_version", header.format_version)
+        .map_err(attr_err("format_version"))?;
+    put_str_attr(file, "engine_version", &meta.engine_version)
+        .map_err(attr_err("engine_version"))?;
+    put_scalar_attr(file, "step", header.step).map_err(attr_err("step"))?;
+    put_scalar_attr(file, "time_s", header.time_s).map_err(attr_err("time_s"))?;
+    put_scalar_attr(file, "dt_s", header.dt_s).map_err(attr_err("dt_s"))?;
+    put_str_list_attr(file, "model_names", &meta.model_names).map_err(attr_err("model_names"))?;
+    put_str_list_attr(file, "wall_names", &meta.wall_names).map_err(attr_err("wall_names"))?;
+    put_str_attr(file, "scenario_json", &meta.scenario_json).map_err(attr_err("scenario_json"))?;
+    put_scalar_attr(file, "checksum_xxh3_64", sum).map_err(attr_err("checksum_xxh3_64"))?;
+    for group in GROUPS {
+        file.create_group(group)
+            .map_err(|e| CheckpointError::hdf5(tmp, format!("creating group /{group}"), e))?;
+    }
+    arrays.visit(&mut Writer { file, path: tmp })
+}
+
+fn vlen(s: &str) -> hdf5::Result<VarLenUnicode> {
+    s.parse::<VarLenUnicode>()
+        .map_err(|_| hdf5::Error::from("string contains a NUL character"))
+}
+
+fn put_scalar_attr<T: H5Type>(loc: &Location, name: &str, value: T) -> hdf5::Result<()> {
+    loc.new_attr::<T>().create(name)?.write_scalar(&value)
+}
+
+fn put_str_attr(loc: &Location, name: &str, value: &str) -> hdf5::Result<()> {
+    put_scalar_attr(loc, name, vlen(value)?)
+}
+
+fn put_str_list_attr(loc: &Location, name: &str, values: &[String]) -> hdf5::Result<()> {
+    let values = values
+        .iter()
+        .map(|s| vlen(s))
+        .collect::<hdf5::Result<Vec<_>>>()?;
+    let attr = loc
+        .new_attr::<VarLenUnicode>()
+        .shape([values.len()])
+        .create(name)?;
+    if values.is_empty() {
+        Ok(())
+    } else {
+        attr.write_raw(values.as_slice())
+    }
+}
+
+/// Writes each dataset of [`Arrays`] with its `units` attribute.
+struct Writer<'a> {
+    file: &'a hdf5::File,
+    path: &'a Path,
+}
+
+impl Visitor for Writer<'_> {
+    type Error = CheckpointError;
+
+    fn visit<T: Element>(&mut self, spec: &DatasetSpec, data: &[T]) -> Result<(), CheckpointError> {
+        let err =
+            |e: hdf5::Error| CheckpointError::hdf5(self.path, format!("writing /{}", spec.path), e);
+        let shape = spec.shape(data.len());
+        let ds = self
+            .file
+            .new_dataset::<T>()
+            .shape(shape.as_slice())
+            .create(spec.path)
+            .map_err(err)?;
+        match data {
+            [] => {}
+            [value] if spec.rows == Rows::Scalar => ds.write_scalar(value).map_err(err)?,
+            _ => ds.write_raw(data).map_err(err)?,
+        }
+        put_str_attr(&ds, "units", spec.units).map_err(err)
+    }
+}
+
+/// Reads and verifies the checkpoint at `path`: the seal (length and file checksum, before libhdf5 parses the
+/// file), format name and version, element types and shapes, content checksum, and the consistency of the arrays
+/// (contacts refer to existing particles and walls). Returns exactly the state and metadata that were written.
+pub fn read_checkpoint(path: &Path) -> Result<(SimState, CheckpointMeta), CheckpointError> {
+    // Before libhdf5 parses anything: it does not survive every kind of damage (see `layout`).
+    verify_seal(path)?;
+    let file_len = std::fs::metadata(path)
+        .map_err(|e| CheckpointError::io(path, "reading the file's metadata", e))?
+        .len();
+    let file =
+        hdf5::File::open(path).map_err(|e| CheckpointError::hdf5(path, "opening the file", e))?;
+    let mut reader = Reader {
+        file: &file,
+        path,
+        file_len,
+    };
+
+    let format = reader.str_attr("format")?;
+    if format != FORMAT_NAME {
+        return Err(CheckpointError::corrupt(
+            path,
+            format!("root attribute format is {format:?}, expected {FORMAT_NAME:?}"),
+        ));
+    }
+    let format_version = reader.scalar_attr::<u32>("format_version")?;
+    if format_version != CHECKPOINT_FORMAT_VERSION {
+        return Err(CheckpointError::Version {
+            path: path.to_path_buf(),
+            found: format_version,
+            expected: CHECKPOINT_FORMAT_VERSION,
+        });
+    }
+    let meta = CheckpointMeta {
+        engine_version: reader.str_attr("engine_version")?,
+        model_names: reader.str_list_attr("model_names")?,
+        wall_names: reader.str_list_attr("wall_names")?,
+        scenario_json: reader.str_attr("scenario_json")?,
+    };
+    let header = Header {
+        format_version,
+        step: reader.scalar_attr("step")?,
+        time_s: reader.scalar_attr("time_s")?,
+        dt_s: reader.scalar_attr("dt_s")?,
+        meta: &meta,
+    };
+    let stored = reader.scalar_attr::<u64>("checksum_xxh3_64")?;
+    let mut arrays = Arrays::default();
+    arrays.visit_mut(&mut reader)?;
+    drop(file);
+
+    let computed = checksum(&header, &arrays);
+    if computed != stored {
+        return Err(CheckpointError::corrupt(
+            path,
+            format!("content checksum mismatch (stored {stored:#018x}, computed {computed:#018x})"),
+        ));
+    }
+    arrays
+        .check()
+        .map_err(|reason| CheckpointError::corrupt(path, reason))?;
+    let state = arrays.into_state(&header);
+    Ok((state, meta))
+}
+
+/// Reads attributes and datasets, checking presence, element type and shape before reading any data.
+struct Reader<'a> {
+    file: &'a hdf5::File,
+    path: &'a Path,
+    /// Size of the file in bytes: no dataset can hold more, which bounds allocations on corrupt shapes.
+    file_len: u64,
+}
+
+impl Reader<'_> {
+    fn hdf5_err(&self, context: String) -> impl FnOnce(hdf5::Error) -> CheckpointError + '_ {
+        move |e| CheckpointError::hdf5(self.path, context, e)
+    }
+
+    fn corrupt(&self, reason: String) -> CheckpointError {
+        CheckpointError::corrupt(self.path, reason)
+    }
+
+    /// Fails unless `actual` is exactly the type `T` is written as.
+    fn check_type<T: H5Type>(&self, actual: &Datatype, what: &str) -> Result<(), CheckpointError> {
+        let expected = Datatype::from_type::<T>()
+            .map_err(self.hdf5_err(format!("building the type of {what}")))?;
+        if *actual == expected {
+            Ok(())
+        } else {
+            Err(self.corrupt(format!("{what} has type {actual:?}, expected {expected:?}")))
+        }
+    }
+
+    /// Opens root attribute `name` after checking that it exists and has type `T` and rank `rank`.
+    fn attr<T: H5Type>(
+        &self,
+        name: &str,
+        rank: usize,
+    ) -> Result<(hdf5::Attribute, Vec<usize>), CheckpointError> {
+        let what = format!("root attribute {name}");
+        let names = self
+            .file
+            .attr_names()
+            .map_err(self.hdf5_err("listing the root attributes".to_string()))?;
+        if !names.iter().any(|n| n == name) {
+            return Err(self.corrupt(format!("missing {what}")));
+        }
+        let attr = self
+            .file
+            .attr(name)
+            .map_err(self.hdf5_err(format!("opening {what}")))?;
+        let dtype = attr
+            .dtype()
+            .map_err(self.hdf5_err(format!("reading the type of {what}")))?;
+        self.check_type::<T>(&dtype, &what)?;
+        let shape = attr
+            .get_shape()
+            .map_err(self.hdf5_err(format!("reading the shape of {what}")))?;
+        if shape.len() != rank {
+            return Err(self.corrupt(format!("{what} has shape {shape:?}, expected rank {rank}")));
+        }
+        Ok((attr, shape))
+    }
+
+    fn scalar_attr<T: H5Type>(&self, name: &str) -> Result<T, CheckpointError> {
+        let (attr, _) = self.attr::<T>(name, 0)?;
+        attr.read_scalar::<T>()
+            .map_err(self.hdf5_err(format!("reading root attribute {name}")))
+    }
+
+    fn utf8(&self, name: &str, v: &VarLenUnicode) -> Result<String, CheckpointError> {
+        String::from_utf8(v.as_bytes().to_vec())
+            .map_err(|_| self.corrupt(format!("root attribute {name} is not valid UTF-8")))
+    }
+
+    fn str_attr(&self, name: &str) -> Result<String, CheckpointError> {
+        let v = self.scalar_attr::<VarLenUnicode>(name)?;
+        self.utf8(name, &v)
+    }
+
+    fn str_list_attr(&self, name: &str) -> Result<Vec<String>, CheckpointError> {
+        let (attr, shape) = self.attr::<VarLenUnicode>(name, 1)?;
+        if shape[0] == 0 {
+            return Ok(Vec::new());
+        }
+        let values = attr
+            .read_raw::<VarLenUnicode>()
+            .map_err(self.hdf5_err(format!("reading root attribute {name}")))?;
+        values.iter().map(|v| self.utf8(name, v)).collect()
+    }
+}
+
+impl VisitorMut for Reader<'_> {
+    type Error = CheckpointError;
+
+    fn visit<T: Element>(
+        &mut self,
+        spec: &DatasetSpec,
+        data: &mut Vec<T>,
+    ) -> Result<(), CheckpointError> {
+        let what = format!("dataset /{}", spec.path);
+        if !self.file.link_exists(spec.path) {
+            return Err(self.corrupt(format!("missing {what}")));
+        }
+        let ds = self
+            .file
+            .dataset(spec.path)
+            .map_err(self.hdf5_err(format!("opening {what}")))?;
+        let dtype = ds
+            .dtype()
+            .map_err(self.hdf5_err(format!("reading the type of {what}")))?;
+        self.check_type::<T>(&dtype, &what)?;
+        let shape = ds
+            .get_shape()
+            .map_err(self.hdf5_err(format!("reading the shape of {what}")))?;
+        let shape_ok = match (spec.rows, shape.as_slice()) {
+            (Rows::Scalar, []) => true,
+            (Rows::Fixed(n), [m]) => *m == n,
+            (Rows::Scalar | Rows::Fixed(_), _) => false,
+            (_, [_]) => spec.width == 1,
+            (_, [_, w]) => spec.width > 1 && *w == spec.width,
+            _ => false,
+        };
+        if !shape_ok {
+            return Err(self.corrupt(format!(
+                "{what} has shape {shape:?}, expected {}",
+                expected_shape(spec)
+            )));
+        }
+        let len = shape.iter().try_fold(1usize, |acc, &d| acc.checked_mul(d));
+        let bytes = len.and_then(|n| n.checked_mul(std::mem::size_of::<T>()));
+        let len = match (len, bytes) {
+            (Some(len), Some(bytes)) if bytes as u64 <= self.file_len => len,
+            _ => {
+                return Err(self.corrupt(format!(
+                    "{what} has shape {shape:?}, larger than the file ({} bytes)",
+                    self.file_len
+                )));
+            }
+        };
+        // The element type was checked equal above, so reading converts nothing.
+        let reader = ds.as_reader();
+        let context = format!("reading {what}");
+        *data = if spec.rows == Rows::Scalar {
+            vec![reader.read_scalar::<T>().map_err(self.hdf5_err(context))?]
+        } else if len == 0 {
+            Vec::new()
+        } else {
+            reader.read_raw::<T>().map_err(self.hdf5_err(context))?
+        };
+        if data.len() != len {
+            return Err(self.corrupt(format!(
+                "{what} read {} elements, expected {len}",
+                data.len()
+            )));
+        }
+        Ok(())
+    }
+}
+
+/// The expected shape of a dataset, for error messages, e.g. `[N, 3]`.
+fn expected_shape(spec: &DatasetSpec) -> String {
+    let rows = match spec.rows {
+        Rows::Particles => "N".to_string(),
+        Rows::PairContacts => "pair contacts".to_string(),
+        Rows::WallContacts => "wall contacts".to_string(),
+        Rows::Walls => "walls".to_string(),
+        Rows::Fixed(n) => n.to_string(),
+        Rows::Scalar => return "scalar".to_string(),
+    };
+    if spec.width == 1 {
+        format!("[{rows}]")
+    } else {
+        format!("[{rows}, {}]", spec.width)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::engine::Vec3;
+    use crate::engine::contacts::{ContactStore, WallId};
+    use crate::engine::models::ContactHistory;
+    use crate::engine::particles::{ParticleId, Particles, SpeciesId};
+    use crate::engine::state::RngState;
+
+    /// A value placed once in the positions, to find its bytes in the file.
+    const DISTINCTIVE: f64 = 0.731_592_653_589_793_2e-3;
+    const SUBNORMAL: f64 = f64::from_bits(1);
+
+    fn v(x: f64, y: f64, z: f64) -> Vec3 {
+        Vec3::new(x, y, z)
+    }
+
+    fn history(k: f64, yielded: bool) -> ContactHistory {
+        ContactHistory {
+            active: true,
+            yielded,
+            tangential: v(1.1e-7 * k, -2.3e-8 * k, -0.0),
+            reversal_force_n: v(0.31 * k, 1.7e-3, -4.9e-2 * k),
+            increment_direction: v(0.6, -0.8 * k / k.abs(), SUBNORMAL),
+            max_overlap_m: 3.3e-6 * k,
+            max_normal_force_n: 12.75 + k,
+        }
+    }
+
+    fn sample_state() -> SimState {
+        let mut p = Particles::default();
+        for i in 0..5u32 {
+            let f = f64::from(i) + 1.0;
+            p.id.push(ParticleId(i));
+            p.species.push(SpeciesId((i % 2) as u16));
+            p.radius_m.push(1.0e-3 * (1.0 + 0.1234567 * f));
+            p.mass_kg.push(2.5e-6 * f.sqrt());
+            p.inertia_kg_m2.push(1.0e-12 / 3.0 * f);
+            p.position_m
+                .push(v(0.01 * f / 7.0, -0.003 * f, 0.1 + 1.0 / (f + 13.0)));
+            p.velocity_m_per_s
+                .push(v(-0.0, 1.0e-310 * f, 0.577_215_664 * f));
+            p.angular_velocity_rad_per_s
+                .push(v(SUBNORMAL, -SUBNORMAL * f, 3.0 / f));
+            p.force_n
+                .push(v(f * 1.0e-3 / 3.0, -9.81 * f, f64::MIN_POSITIVE));
+            p.torque_n_m.push(v(
+                -1.0e-9 * f,
+                f64::from_bits(0x7ff8_0000_dead_beef),
+                f64::MAX / f,
+            ));
+        }
+        p.position_m[2].x = DISTINCTIVE;
+        let contacts = ContactStore {
+            pairs: vec![
+                (ParticleId(0), ParticleId(1), history(1.0, false)),
+                (ParticleId(0), ParticleId(3), history(-2.0, true)),
+                (ParticleId(2), ParticleId(4), history(3.5, false)),
+            ],
+            walls: vec![
+                (ParticleId(1), WallId(0), history(-0.5, true)),
+                (ParticleId(3), WallId(1), history(7.25, false)),
+            ],
+        };
+        let mut seed = [0u8; 32];
+        for (k, b) in seed.iter_mut().enumerate() {
+            *b = (k as u8).wrapping_mul(37).wrapping_add(11);
+        }
+        SimState {
+            step: 123_456_789,
+            time_s: 0.012_345_678_9,
+            dt_s: 1.0e-6 + f64::EPSILON,
+            particles: p,
+            wall_angle_rad: vec![0.25, -1.5e-7],
+            contacts,
+            rng: RngState {
+                seed,
+                stream: 0xdead_beef_1234_5678,
+                word_pos: (1u128 << 70) + 12_345,
+            },
+        }
+    }
+
+    fn sample_meta() -> CheckpointMeta {
+        CheckpointMeta {
+            engine_version: env!("CARGO_PKG_VERSION").to_string(),
+            model_names: vec!["thornton".into(), "walton_braun".into(), "none".into()],
+            wall_names: vec!["drum".into(), "lid".into()],
+            scenario_json: r#"{"name":"tumbler","μ":0.3,"walls":["drum","lid"]}"#.to_string(),
+        }
+    }
+
+    fn f64s_differ(a: &[f64], b: &[f64]) -> bool {
+        a.len() != b.len() || a.iter().zip(b).any(|(x, y)| x.to_bits() != y.to_bits())
+    }
+
+    fn vecs_differ(a: &[Vec3], b: &[Vec3]) -> bool {
+        a.len() != b.len()
+            || a.iter()
+                .zip(b)
+                .any(|(x, y)| f64s_differ(x.as_slice(), y.as_slice()))
+    }
+
+    fn history_diff(a: &ContactHistory, b: &ContactHistory) -> Option<&'static str> {
+        let vec = |x: &Vec3, y: &Vec3| f64s_differ(x.as_slice(), y.as_slice());
+        if a.active != b.active {
+            Some("active")
+        } else if a.yielded != b.yielded {
+            Some("yielded")
+        } else if vec(&a.tangential, &b.tangential) {
+            Some("tangential")
+        } else if vec(&a.reversal_force_n, &b.reversal_force_n) {
+            Some("reversal_force_n")
+        } else if vec(&a.increment_direction, &b.increment_direction) {
+            Some("increment_direction")
+        } else if a.max_overlap_m.to_bits() != b.max_overlap_m.to_bits() {
+            Some("max_overlap_m")
+        } else if a.max_normal_force_n.to_bits() != b.max_normal_force_n.to_bits() {
+            Some("max_normal_force_n")
+        } else {
+            None
+        }
+    }
+
+    /// Compares two states bit for bit (f64 by `to_bits`) and names the first differing field.
+    fn state_diff(a: &SimState, b: &SimState) -> Result<(), String> {
+        let (pa, pb) = (&a.particles, &b.particles);
+        let checks: [(&str, bool); 16] = [
+            ("step", a.step != b.step),
+            ("time_s", a.time_s.to_bits() != b.time_s.to_bits()),
+            ("dt_s", a.dt_s.to_bits() != b.dt_s.to_bits()),
+            ("particles.id", pa.id != pb.id),
+            ("particles.species", pa.species != pb.species),
+            (
+                "particles.radius_m",
+                f64s_differ(&pa.radius_m, &pb.radius_m),
+            ),
+            ("particles.mass_kg", f64s_differ(&pa.mass_kg, &pb.mass_kg)),
+            (
+                "particles.inertia_kg_m2",
+                f64s_differ(&pa.inertia_kg_m2, &pb.inertia_kg_m2),
+            ),
+            (
+                "particles.position_m",
+                vecs_differ(&pa.position_m, &pb.position_m),
+            ),
+            (
+                "particles.velocity_m_per_s",
+                vecs_differ(&pa.velocity_m_per_s, &pb.velocity_m_per_s),
+            ),
+            (
+                "particles.angular_velocity_rad_per_s",
+                vecs_differ(
+                    &pa.angular_velocity_rad_per_s,
+                    &pb.angular_velocity_rad_per_s,
+                ),
+            ),
+            ("particles.force_n", vecs_differ(&pa.force_n, &pb.force_n)),
+            (
+                "particles.torque_n_m",
+                vecs_differ(&pa.torque_n_m, &pb.torque_n_m),
+            ),
+            (
+                "wall_angle_rad",
+                f64s_differ(&a.wall_angle_rad, &b.wall_angle_rad),
+            ),
+            ("rng", a.rng != b.rng),
+            (
+                "contacts (count)",
+                a.contacts.pairs.len() != b.contacts.pairs.len()
+                    || a.contacts.walls.len() != b.contacts.walls.len(),
+            ),
+        ];
+        if let Some((name, _)) = checks.iter().find(|(_, differs)| *differs) {
+            return Err(format!("field {name} differs"));
+        }
+        for (k, (x, y)) in a.contacts.pairs.iter().zip(&b.contacts.pairs).enumerate() {
+            if (x.0, x.1) != (y.0, y.1) {
+                return Err(format!("contacts.pairs[{k}] key differs"));
+            }
+            if let Some(f) = history_diff(&x.2, &y.2) {
+                return Err(format!("contacts.pairs[{k}].{f} differs"));
+            }
+        }
+        for (k, (x, y)) in a.contacts.walls.iter().zip(&b.contacts.walls).enumerate() {
+            if (x.0, x.1) != (y.0, y.1) {
+                return Err(format!("contacts.walls[{k}] key differs"));
+            }
+            if let Some(f) = history_diff(&x.2, &y.2) {
+                return Err(format!("contacts.walls[{k}].{f} differs"));
+            }
+        }
+        Ok(())
+    }
+
+    fn round_trip(state: &SimState, meta: &CheckpointMeta) {
+        let dir = tempfile::tempdir().expect("tempdir");
+        let path = dir.path().join("ckpt-000000000001.h5");
+        write_checkpoint(&path, state, meta).expect("write");
+        assert!(!tmp_path(&path).exists(), "temporary file left behind");
+        let (back, back_meta) = read_checkpoint(&path).expect("read");
+        if let Err(e) = state_diff(state, &back) {
+            panic!("round trip changed the state: {e}");
+        }
+        assert_eq!(&back_meta, meta);
+    }
+
+    fn flip_bit_at_value(path: &Path, value: f64) {
+        let mut bytes = std::fs::read(path).expect("read file");
+        let needle = value.to_le_bytes();
+        let hits: Vec<usize> = bytes
+            .windows(8)
+            .enumerate()
+            .filter(|(_, w)| *w == needle)
+            .map(|(k, _)| k)
+            .collect();
+        assert_eq!(
+            hits.len(),
+            1,
+            "the distinctive value must occur exactly once in the file"
+        );
+        bytes[hits[0] + 3] ^= 0x10;
+        std::fs::write(path, bytes).expect("write file");
+    }
+
+    #[test]
+    fn round_trip_is_bit_identical() {
+        let state = sample_state();
+        assert!(state.rng.word_pos > u128::from(u64::MAX));
+        round_trip(&state, &sample_meta());
+    }
+
+    #[test]
+    fn state_diff_names_the_first_differing_field() {
+        let a = sample_state();
+        let mut b = a.clone();
+        b.particles.velocity_m_per_s[0].x = 0.0; // was -0.0: equal as numbers, different bits
+        assert_eq!(
+            state_diff(&a, &b),
+            Err("field particles.velocity_m_per_s differs".to_string())
+        );
+        let mut c = a.clone();
+        c.contacts.walls[1].2.max_overlap_m += 1e-20;
+        assert_eq!(
+            state_diff(&a, &c),
+            Err("contacts.walls[1].max_overlap_m differs".to_string())
+        );
+    }
+
+    #[test]
+    fn empty_contacts_and_no_walls_round_trip() {
+        let mut state = sample_state();
+        state.contacts = ContactStore::default();
+        state.wall_angle_rad.clear();
+        let meta = CheckpointMeta {
+            wall_names: Vec::new(),
+            model_names: Vec::new(),
+            scenario_json: String::new(),
+            ..sample_meta()
+        };
+        round_trip(&state, &meta);
+    }
+
+    #[test]
+    fn no_particles_round_trip() {
+        let mut state = sample_state();
+        state.particles = Particles::default();
+        state.contacts = ContactStore::default();
+        round_trip(&state, &sample_meta());
+    }
+
+    #[test]
+    fn large_scenario_json_round_trips() {
+        let meta = CheckpointMeta {
+            scenario_json: "{\"x\":1234567890}".repeat(20_000),
+            ..sample_meta()
+        };
+        round_trip(&sample_state(), &meta);
+    }
+
+    #[test]
+    fn truncated_file_is_an_error_naming_the_file() {
+        let dir = tempfile::tempdir().expect("tempdir");
+        let path = dir.path().join("ckpt-000000000001.h5");
+        write_checkpoint(&path, &sample_state(), &sample_meta()).expect("write");
+        let bytes = std::fs::read(&path).expect("read file");
+        std::fs::write(&path, &bytes[..bytes.len() / 2]).expect("truncate");
+        let err = read_checkpoint(&path).expect_err("a truncated file must not read");
+        assert_eq!(err.path(), path);
+        assert!(
+            err.to_string().contains(&path.display().to_string()),
+            "{err}"
+        );
+    }
+
+    #[test]
+    fn flipped_bit_in_data_is_a_checksum_mismatch() {
+        let dir = tempfile::tempdir().expect("tempdir");
+        let path = dir.path().join("ckpt-000000000001.h5");
+        write_checkpoint(&path, &sample_state(), &sample_meta()).expect("write");
+        flip_bit_at_value(&path, DISTINCTIVE);
+        let err = read_checkpoint(&path).expect_err("a flipped bit must be detected");
+        assert!(matches!(err, CheckpointError::Corrupt { .. }), "{err:?}");
+        let msg = err.to_string();
+        assert!(msg.contains("checksum mismatch"), "{msg}");
+        assert!(msg.contains(&path.display().to_string()), "{msg}");
+    }
+
+    #[test]
+    fn changed_content_is_a_content_checksum_mismatch() {
+        let dir = tempfile::tempdir().expect("tempdir");
+        let path = dir.path().join("ckpt-000000000001.h5");
+        let state = sample_state();
+        write_checkpoint(&path, &state, &sample_meta()).expect("write");
+        {
+            let file = hdf5::File::open_rw(&path).expect("open");
+            let mut radius = state.particles.radius_m.clone();
+            radius[3] = f64::from_bits(radius[3].to_bits() ^ 1);
+            file.dataset("particles/radius_m")
+                .expect("dataset")
+                .write_raw(&radius)
+                .expect("write");
+        }
+        // A valid seal over the changed file: only the content checksum can notice.
+        seal(&path).expect("reseal");
+        let err = read_checkpoint(&path).expect_err("changed content must be detected");
+        assert!(matches!(err, CheckpointError::Corrupt { .. }), "{err:?}");
+        assert!(
+            err.to_string().contains("content checksum mismatch"),
+            "{err}"
+        );
+    }
+
+    #[test]
+    fn truncated_hdf5_behind_a_valid_seal_is_an_hdf5_error() {
+        let dir = tempfile::tempdir().expect("tempdir");
+        let path = dir.path().join("ckpt-000000000001.h5");
+        write_checkpoint(&path, &sample_state(), &sample_meta()).expect("write");
+        let bytes = std::fs::read(&path).expect("read file");
+        std::fs::write(&path, &bytes[..bytes.len() / 2]).expect("truncate");
+        seal(&path).expect("reseal");
+        let err = read_checkpoint(&path).expect_err("libhdf5 must refuse a truncated file");
+        assert!(matches!(err, CheckpointError::Hdf5 { .. }), "{err:?}");
+        assert!(
+            err.to_string().contains(&path.display().to_string()),
+            "{err}"
+        );
+    }
+
+    #[test]
+    fn every_flipped_bit_and_every_cut_is_rejected() {
+        let dir = tempfile::tempdir().expect("tempdir");
+        let path = dir.path().join("ckpt-000000000001.h5");
+        write_checkpoint(&path, &sample_state(), &sample_meta()).expect("write");
+        let orig = std::fs::read(&path).expect("read file");
+        // Every byte of the seal block, then every 7th byte (the same check covers all of them; this keeps the
+        // test fast in debug builds).
+        let offsets = (0..SEAL_BYTES as usize).chain((SEAL_BYTES as usize..orig.len()).step_by(7));
+        for k in offsets {
+            let mut bytes = orig.clone();
+            bytes[k] ^= 1 << (k % 8);
+            std::fs::write(&path, &bytes).expect("write file");
+            let err = read_checkpoint(&path).expect_err("a flipped bit must be detected");
+            assert!(
+                matches!(err, CheckpointError::Corrupt { .. }),
+                "byte {k}: {err:?}"
+            );
+        }
+        for len in (0..orig.len()).step_by(97) {
+            std::fs::write(&path, &orig[..len]).expect("write file");
+            let err = read_checkpoint(&path).expect_err("a cut file must be detected");
+            assert!(
+                matches!(err, CheckpointError::Corrupt { .. }),
+                "length {len}: {err:?}"
+            );
+        }
+    }
+
+    #[test]
+    fn other_version_is_rejected() {
+        let dir = tempfile::tempdir().expect("tempdir");
+        let path = dir.path().join("ckpt-000000000001.h5");
+        write_checkpoint(&path, &sample_state(), &sample_meta()).expect("write");
+        {
+            let file = hdf5::File::open_rw(&path).expect("open");
+            file.attr("format_version")
+                .expect("attr")
+                .write_scalar(&7u32)
+                .expect("write attr");
+        }
+        seal(&path).expect("reseal");
+        let err = read_checkpoint(&path).expect_err("version 7 must be rejected");
+        assert!(
+            matches!(
+                err,
+                CheckpointError::Version {
+                    found: 7,
+                    expected: CHECKPOINT_FORMAT_VERSION,
+                    ..
+                }
+            ),
+            "{err:?}"
+        );
+    }
+
+    #[test]
+    fn foreign_hdf5_file_is_rejected() {
+        let dir = tempfile::tempdir().expect("tempdir");
+        let path = dir.path().join("other.h5");
+        {
+            let file = hdf5::File::create(&path).expect("create");
+            file.new_dataset::<f64>()
+                .shape([3])
+                .create("x")
+                .expect("dataset");
+        }
+        let err = read_checkpoint(&path).expect_err("not a checkpoint");
+        assert!(err.to_string().contains("no checkpoint seal"), "{err}");
+        // Even with a valid seal, a file without the checkpoint attributes is rejected by name.
+        std::fs::remove_file(&path).expect("remove");
+        {
+            let file = hdf5::File::with_options()
+                .with_fcpl(|p| p.userblock(SEAL_BYTES))
+                .create(&path)
+                .expect("create");
+            file.new_dataset::<f64>()
+                .shape([3])
+                .create("x")
+                .expect("dataset");
+        }
+        seal(&path).expect("seal");
+        let err = read_checkpoint(&path).expect_err("not a checkpoint");
+        assert!(
+            err.to_string().contains("missing root attribute format"),
+            "{err}"
+        );
+    }
+
+    #[test]
+    fn inconsistent_state_is_not_written() {
+        let dir = tempfile::tempdir().expect("tempdir");
+        let path = dir.path().join("ckpt-000000000001.h5");
+        let mut state = sample_state();
+        state.contacts.walls[0].1 = WallId(5);
+        let err =
+            write_checkpoint(&path, &state, &sample_meta()).expect_err("wall 5 does not exist");
+        assert!(
+            matches!(err, CheckpointError::InvalidState { .. }),
+            "{err:?}"
+        );
+        let mut state = sample_state();
+        state.particles.mass_kg.pop();
+        let err = write_checkpoint(&path, &state, &sample_meta()).expect_err("mass_kg is short");
+        assert!(err.to_string().contains("/particles/mass_kg"), "{err}");
+        assert!(!path.exists() && !tmp_path(&path).exists());
+    }
+
+    #[test]
+    fn series_keeps_newest_and_falls_back_past_corrupt() {
+        let dir = tempfile::tempdir().expect("tempdir");
+        let series = CheckpointSeries::new(dir.path().join("run"), 3);
+        let meta = sample_meta();
+        let mut state = sample_state();
+        for step in [100, 200, 300, 400] {
+            state.step = step;
+            let path = series.write(&state, &meta).expect("write");
+            assert_eq!(path, series.path_for_step(step));
+        }
+        let steps: Vec<u64> = series
+            .list()
+            .expect("list")
+            .into_iter()
+            .map(|(s, _)| s)
+            .collect();
+        assert_eq!(steps, [400, 300, 200]);
+        assert!(!series.path_for_step(100).exists());
+
+        let newest = series.path_for_step(400);
+        flip_bit_at_value(&newest, DISTINCTIVE);
+        let loaded = series
+            .latest_valid()
+            .expect("latest_valid")
+            .expect("a valid checkpoint");
+        assert_eq!(loaded.path, series.path_for_step(300));
+        assert_eq!(loaded.state.step, 300);
+        assert_eq!(loaded.meta, meta);
+        assert_eq!(loaded.rejected.len(), 1);
+        assert_eq!(loaded.rejected[0].path(), newest);
+        assert!(
+            loaded.rejected[0]
+                .to_string()
+                .contains("ckpt-000000000400.h5")
+        );
+
+        // Truncating the next one as well falls back to 200, with both rejections listed newest first.
+        let p300 = series.path_for_step(300);
+        let bytes = std::fs::read(&p300).expect("read");
+        std::fs::write(&p300, &bytes[..bytes.len() / 2]).expect("truncate");
+        let loaded = series
+            .latest_valid()
+            .expect("latest_valid")
+            .expect("a valid checkpoint");
+        assert_eq!(loaded.state.step, 200);
+        let rejected: Vec<&Path> = loaded.rejected.iter().map(|e| e.path()).collect();
+        assert_eq!(rejected, [newest.as_path(), p300.as_path()]);
+    }
+
+    #[test]
+    fn series_without_valid_checkpoints_is_none() {
+        let dir = tempfile::tempdir().expect("tempdir");
+        let series = CheckpointSeries::new(dir.path().join("missing"), 2);
+        assert!(series.list().expect("list").is_empty());
+        assert!(series.latest_valid().expect("latest_valid").is_none());
+        std::fs::create_dir_all(series.dir()).expect("mkdir");
+        std::fs::write(series.path_for_step(5), b"not hdf5").expect("write");
+        assert!(series.latest_valid().expect("latest_valid").is_none());
+    }
+
+    #[test]
+    fn file_name_must_match_step() {
+        let dir = tempfile::tempdir().expect("tempdir");
+        let series = CheckpointSeries::new(dir.path(), 2);
+        let state = sample_state();
+        write_checkpoint(&series.path_for_step(999), &state, &sample_meta()).expect("write");
+        assert!(series.latest_valid().expect("latest_valid").is_none());
+    }
+
+    #[test]
+    fn list_ignores_tmp_and_other_files() {
+        let dir = tempfile::tempdir().expect("tempdir");
+        let series = CheckpointSeries::new(dir.path(), 3);
+        let mut state = sample_state();
+        state.step = 10;
+        series.write(&state, &sample_meta()).expect("write");
+        let tmp = tmp_path(&series.path_for_step(20));
+        std::fs::write(&tmp, b"half-written").expect("write tmp");
+        for other in [
+            "notes.txt",
+            "ckpt-.h5",
+            "ckpt-12x.h5",
+            "ckpt-000000000030.h5.bak",
+        ] {
+            std::fs::write(dir.path().join(other), b"x").expect("write other");
+        }
+        std::fs::create_dir(series.path_for_step(40)).expect("mkdir");
+        let listed = series.list().expect("list");
+        assert_eq!(listed, [(10, series.path_for_step(10))]);
+        let loaded = series.latest_valid().expect("latest_valid").expect("valid");
+        assert!(loaded.rejected.is_empty());
+        // Writing again does not trip over (or delete) the leftover temporary file of another step.
+        state.step = 11;
+        series.write(&state, &sample_meta()).expect("write");
+        assert!(tmp.exists());
+    }
+
+    #[test]
+    fn series_never_deletes_the_file_just_written() {
+        let dir = tempfile::tempdir().expect("tempdir");
+        let series = CheckpointSeries::new(dir.path(), 1);
+        let mut state = sample_state();
+        state.step = 500;
+        series.write(&state, &sample_meta()).expect("write");
+        state.step = 300;
+        let path = series.write(&state, &sample_meta()).expect("write");
+        assert!(path.exists());
+    }
+
+    /// Recomputes `checksum_xxh3_64` from the recipe in `schemas/checkpoint.md`, independently of `layout`.
+    #[test]
+    fn content_checksum_follows_the_documented_recipe() {
+        fn s(out: &mut Vec<u8>, v: &str) {
+            out.extend((v.len() as u64).to_le_bytes());
+            out.extend(v.as_bytes());
+        }
+        fn ds(out: &mut Vec<u8>, path: &str, shape: &[usize], data: &[u8]) {
+            s(out, path);
+            out.extend((shape.len() as u64).to_le_bytes());
+            for &d in shape {
+                out.extend((d as u64).to_le_bytes());
+            }
+            out.extend(data);
+        }
+        fn f(v: impl IntoIterator<Item = f64>) -> Vec<u8> {
+            v.into_iter()
+                .flat_map(|x| x.to_bits().to_le_bytes())
+                .collect()
+        }
+        fn v3(v: &[Vec3]) -> Vec<u8> {
+            f(v.iter().flat_map(|x| [x.x, x.y, x.z]))
+        }
+        let state = sample_state();
+        let meta = sample_meta();
+        let dir = tempfile::tempdir().expect("tempdir");
+        let path = dir.path().join("ckpt-000000000001.h5");
+        write_checkpoint(&path, &state, &meta).expect("write");
+        let stored: u64 = hdf5::File::open(&path)
+            .expect("open")
+            .attr("checksum_xxh3_64")
+            .expect("attr")
+            .read_scalar()
+            .expect("read");
+
+        let mut b = Vec::new();
+        s(&mut b, "granflow-checkpoint");
+        b.extend(CHECKPOINT_FORMAT_VERSION.to_le_bytes());
+        s(&mut b, &meta.engine_version);
+        b.extend(state.step.to_le_bytes());
+        b.extend(state.time_s.to_bits().to_le_bytes());
+        b.extend(state.dt_s.to_bits().to_le_bytes());
+        for list in [&meta.model_names, &meta.wall_names] {
+            b.extend((list.len() as u64).to_le_bytes());
+            for name in list {
+                s(&mut b, name);
+            }
+        }
+        s(&mut b, &meta.scenario_json);
+        let p = &state.particles;
+        let n = p.len();
+        let ids: Vec<u8> = p.id.iter().flat_map(|i| i.0.to_le_bytes()).collect();
+        let species: Vec<u8> = p.species.iter().flat_map(|i| i.0.to_le_bytes()).collect();
+        ds(&mut b, "particles/id", &[n], &ids);
+        ds(&mut b, "particles/species", &[n], &species);
+        ds(
+            &mut b,
+            "particles/radius_m",
+            &[n],
+            &f(p.radius_m.iter().copied()),
+        );
+        ds(
+            &mut b,
+            "particles/mass_kg",
+            &[n],
+            &f(p.mass_kg.iter().copied()),
+        );
+        ds(
+            &mut b,
+            "particles/inertia_kg_m2",
+            &[n],
+            &f(p.inertia_kg_m2.iter().copied()),
+        );
+        ds(&mut b, "particles/position_m", &[n, 3], &v3(&p.position_m));
+        ds(
+            &mut b,
+            "particles/velocity_m_per_s",
+            &[n, 3],
+            &v3(&p.velocity_m_per_s),
+        );
+        let omega = v3(&p.angular_velocity_rad_per_s);
+        ds(
+            &mut b,
+            "particles/angular_velocity_rad_per_s",
+            &[n, 3],
+            &omega,
+        );
+        ds(&mut b, "particles/force_n", &[n, 3], &v3(&p.force_n));
+        ds(&mut b, "particles/torque_n_m", &[n, 3], &v3(&p.torque_n_m));
+        let tables: [(&str, Vec<u8>, Vec<u8>, Vec<ContactHistory>); 2] = [
+            (
+                "pairs",
+                state
+                    .contacts
+                    .pairs
+                    .iter()
+                    .flat_map(|c| c.0.0.to_le_bytes())
+                    .collect(),
+                state
+                    .contacts
+                    .pairs
+                    .iter()
+                    .flat_map(|c| c.1.0.to_le_bytes())
+                    .collect(),
+                state.contacts.pairs.iter().map(|c| c.2).collect(),
+            ),
+            (
+                "walls",
+                state
+                    .contacts
+                    .walls
+                    .iter()
+                    .flat_map(|c| c.0.0.to_le_bytes())
+                    .collect(),
+                state
+                    .contacts
+                    .walls
+                    .iter()
+                    .flat_map(|c| c.1.0.to_le_bytes())
+                    .collect(),
+                state.contacts.walls.iter().map(|c| c.2).collect(),
+            ),
+        ];
+        for (table, i, partner, h) in tables {
+            let m = h.len();
+            let partner_name = if table == "pairs" { "j" } else { "wall" };
+            let flag = |get: fn(&ContactHistory) -> bool| -> Vec<u8> {
+                h.iter().map(|x| u8::from(get(x))).collect()
+            };
+            let vec = |get: fn(&ContactHistory) -> Vec3| v3(&h.iter().map(get).collect::<Vec<_>>());
+            let scalar = |get: fn(&ContactHistory) -> f64| f(h.iter().map(get));
+            ds(&mut b, &format!("contacts/{table}/i"), &[m], &i);
+            ds(
+                &mut b,
+                &format!("contacts/{table}/{partner_name}"),
+                &[m],
+                &partner,
+            );
+            ds(
+                &mut b,
+                &format!("contacts/{table}/active"),
+                &[m],
+                &flag(|x| x.active),
+            );
+            ds(
+                &mut b,
+                &format!("contacts/{table}/yielded"),
+                &[m],
+                &flag(|x| x.yielded),
+            );
+            ds(
+                &mut b,
+                &format!("contacts/{table}/tangential"),
+                &[m, 3],
+                &vec(|x| x.tangential),
+            );
+            let reversal = vec(|x| x.reversal_force_n);
+            ds(
+                &mut b,
+                &format!("contacts/{table}/reversal_force_n"),
+                &[m, 3],
+                &reversal,
+            );
+            let direction = vec(|x| x.increment_direction);
+            ds(
+                &mut b,
+                &format!("contacts/{table}/increment_direction"),
+                &[m, 3],
+                &direction,
+            );
+            ds(
+                &mut b,
+                &format!("contacts/{table}/max_overlap_m"),
+                &[m],
+                &scalar(|x| x.max_overlap_m),
+            );
+            let max_force = scalar(|x| x.max_normal_force_n);
+            ds(
+                &mut b,
+                &format!("contacts/{table}/max_normal_force_n"),
+                &[m],
+                &max_force,
+            );
+        }
+        let walls = state.wall_angle_rad.len();
+        ds(
+            &mut b,
+            "walls/angle_rad",
+            &[walls],
+            &f(state.wall_angle_rad.iter().copied()),
+        );
+        ds(&mut b, "rng/seed", &[32], &state.rng.seed);
+        ds(&mut b, "rng/stream", &[], &state.rng.stream.to_le_bytes());
+        ds(
+            &mut b,
+            "rng/word_pos_hi",
+            &[],
+            &((state.rng.word_pos >> 64) as u64).to_le_bytes(),
+        );
+        ds(
+            &mut b,
+            "rng/word_pos_lo",
+            &[],
+            &(state.rng.word_pos as u64).to_le_bytes(),
+        );
+
+        assert_eq!(stored, xxhash_rust::xxh3::xxh3_64(&b));
+    }
+
+    #[test]
+    fn schema_documents_every_dataset() {
+        let doc = include_str!("../../schemas/checkpoint.md");
+        for spec in layout::DATASETS {
+            assert!(
+                doc.contains(&format!("`/{}`", spec.path)),
+                "schemas/checkpoint.md lacks /{}",
+                spec.path
+            );
+        }
+    }
+}

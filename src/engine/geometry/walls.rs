@@ -1,0 +1,214 @@
+//! Walls: planes, the inside of a rotating cylinder (drum, kiln) and baffle plates fixed to a rotating frame.
+//!
+//! A wall is an infinitely large particle for the contact law (R* = R_i, m* = m_i; LAMMPS/LIGGGHTS do the same),
+//! made of a species of its own. Each wall reports, for a particle centre, the gap to its surface, the outward unit
+//! normal, and the wall's velocity at the contact point. Rotating walls carry an angle that is part of the
+//! simulation state (checkpointed); geometry here is otherwise immutable. Seed 000 builds its tumbler walls and
+//! baffles from glued particles; we use smooth surfaces, which PHYSICS §1 allows if the friction reproduces the flow.
+
+use crate::engine::Vec3;
+use crate::engine::particles::SpeciesId;
+
+/// A frame rotating about an axis: e1, e2 span the plane normal to the axis, e2 = axis × e1.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct RotatingFrame {
+    pub axis_point_m: Vec3,
+    pub axis: Vec3,
+    pub e1: Vec3,
+    pub e2: Vec3,
+    pub angular_velocity_rad_per_s: f64,
+}
+
+impl RotatingFrame {
+    pub fn new(axis_point_m: Vec3, axis: Vec3, angular_velocity_rad_per_s: f64) -> Self {
+        let axis = axis.normalize();
+        let reference = if axis.x.abs() < 0.9 { Vec3::x() } else { Vec3::y() };
+        let e1 = (reference - axis * axis.dot(&reference)).normalize();
+        let e2 = axis.cross(&e1);
+        RotatingFrame {
+            axis_point_m,
+            axis,
+            e1,
+            e2,
+            angular_velocity_rad_per_s,
+        }
+    }
+
+    /// Velocity of the rigid rotation at world point `p`: Ω a × (p − c).
+    #[inline]
+    pub fn velocity_at(&self, p: &Vec3) -> Vec3 {
+        (self.axis * self.angular_velocity_rad_per_s).cross(&(p - self.axis_point_m))
+    }
+
+    /// In-plane coordinates (u, v) of world point `p` in the frame turned by `angle_rad`.
+    #[inline]
+    fn to_body(&self, p: &Vec3, angle_rad: f64) -> (f64, f64) {
+        let r = p - self.axis_point_m;
+        let (u, v) = (r.dot(&self.e1), r.dot(&self.e2));
+        let (s, c) = angle_rad.sin_cos();
+        (u * c + v * s, -u * s + v * c)
+    }
+
+    /// World vector of in-plane body vector (du, dv) in the frame turned by `angle_rad`.
+    #[inline]
+    fn to_world_vector(&self, du: f64, dv: f64, angle_rad: f64) -> Vec3 {
+        let (s, c) = angle_rad.sin_cos();
+        self.e1 * (du * c - dv * s) + self.e2 * (du * s + dv * c)
+    }
+}
+
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum WallShape {
+    /// Infinite plane through `point_m` with unit `normal` pointing into the particle side.
+    Plane { point_m: Vec3, normal: Vec3 },
+    /// Inside surface of a cylinder of radius `radius_m` rotating with `frame`.
+    RotatingCylinder { frame: RotatingFrame, radius_m: f64 },
+    /// A plate of half-thickness `half_thickness_m` whose mid-section is the segment `start`–`end` (in-plane body
+    /// coordinates of `frame`, m), extruded along the axis, turning with `frame`.
+    Baffle {
+        frame: RotatingFrame,
+        start_m: [f64; 2],
+        end_m: [f64; 2],
+        half_thickness_m: f64,
+    },
+}
+
+#[derive(Debug, Clone, PartialEq)]
+pub struct Wall {
+    pub name: String,
+    pub species: SpeciesId,
+    pub shape: WallShape,
+}
+
+/// A particle touching (or near) a wall.
+#[derive(Debug, Clone, Copy)]
+pub struct WallProximity {
+    /// Distance from the particle centre to the wall surface (negative if the centre is behind it).
+    pub gap_m: f64,
+    /// Unit normal from the wall to the particle centre.
+    pub normal: Vec3,
+    /// The wall's velocity at the contact point.
+    pub wall_velocity: Vec3,
+    /// The wall's angular velocity vector (zero for static walls).
+    pub wall_angular_velocity: Vec3,
+}
+
+impl Wall {
+    /// Angular velocity of the wall's rotation (0 for static walls).
+    pub fn angular_velocity_rad_per_s(&self) -> f64 {
+        match &self.shape {
+            WallShape::Plane { .. } => 0.0,
+            WallShape::RotatingCylinder { frame, .. } | WallShape::Baffle { frame, .. } => {
+                frame.angular_velocity_rad_per_s
+            }
+        }
+    }
+
+    /// Largest distance any surface point can move per radian of rotation (for the neighbour-list skin check).
+    pub fn max_lever_m(&self) -> f64 {
+        match &self.shape {
+            // A cylinder's surface moves only tangentially to itself: its gap to any point never changes.
+            WallShape::Plane { .. } | WallShape::RotatingCylinder { .. } => 0.0,
+            WallShape::Baffle {
+                start_m,
+                end_m,
+                half_thickness_m,
+                ..
+            } => {
+                let r0 = (start_m[0].powi(2) + start_m[1].powi(2)).sqrt();
+                let r1 = (end_m[0].powi(2) + end_m[1].powi(2)).sqrt();
+                r0.max(r1) + half_thickness_m
+            }
+        }
+    }
+
+    /// Gap, normal and wall velocity for a particle centre at `x` when the wall has turned by `angle_rad`.
+    #[inline]
+    pub fn proximity(&self, x: &Vec3, angle_rad: f64) -> WallProximity {
+        match &self.shape {
+            WallShape::Plane { point_m, normal } => WallProximity {
+                gap_m: (x - point_m).dot(normal),
+                normal: *normal,
+                wall_velocity: Vec3::zeros(),
+                wall_angular_velocity: Vec3::zeros(),
+            },
+            WallShape::RotatingCylinder { frame, radius_m } => {
+                let r = x - frame.axis_point_m;
+                let radial = r - frame.axis * r.dot(&frame.axis);
+                let rho = radial.norm();
+                let outward = if rho > 0.0 { radial / rho } else { frame.e1 };
+                let contact_point = frame.axis_point_m + frame.axis * r.dot(&frame.axis) + outward * *radius_m;
+                WallProximity {
+                    gap_m: radius_m - rho,
+                    normal: -outward,
+                    wall_velocity: frame.velocity_at(&contact_point),
+                    wall_angular_velocity: frame.axis * frame.angular_velocity_rad_per_s,
+                }
+            }
+            WallShape::Baffle {
+                frame,
+                start_m,
+                end_m,
+                half_thickness_m,
+            } => {
+                let (u, v) = frame.to_body(x, angle_rad);
+                let (su, sv) = (end_m[0] - start_m[0], end_m[1] - start_m[1]);
+                let len2 = su * su + sv * sv;
+                let t = if len2 > 0.0 {
+                    (((u - start_m[0]) * su + (v - start_m[1]) * sv) / len2).clamp(0.0, 1.0)
+                } else {
+                    0.0
+                };
+                let (du, dv) = (u - start_m[0] - t * su, v - start_m[1] - t * sv);
+                let dist = (du * du + dv * dv).sqrt();
+                let normal = if dist > 0.0 {
+                    frame.to_world_vector(du / dist, dv / dist, angle_rad)
+                } else {
+                    frame.to_world_vector(-sv, su, angle_rad).normalize()
+                };
+                let contact_point = x - normal * (dist - half_thickness_m);
+                WallProximity {
+                    gap_m: dist - half_thickness_m,
+                    normal,
+                    wall_velocity: frame.velocity_at(&contact_point),
+                    wall_angular_velocity: frame.axis * frame.angular_velocity_rad_per_s,
+                }
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn cylinder_gap_normal_and_surface_velocity() {
+        let frame = RotatingFrame::new(Vec3::zeros(), Vec3::z(), 2.0);
+        let wall = Wall { name: "drum".into(), species: SpeciesId(0), shape: WallShape::RotatingCylinder { frame, radius_m: 1.0 } };
+        let p = wall.proximity(&Vec3::new(0.0, -0.9, 0.3), 0.0);
+        assert!((p.gap_m - 0.1).abs() < 1e-12);
+        assert!((p.normal - Vec3::new(0.0, 1.0, 0.0)).norm() < 1e-12);
+        // Ω ẑ × (0, −1, 0.3) = (2, 0, 0): the bottom moves towards +x for counter-clockwise rotation.
+        assert!((p.wall_velocity - Vec3::new(2.0, 0.0, 0.0)).norm() < 1e-12);
+    }
+
+    #[test]
+    fn baffle_turns_with_its_frame() {
+        let frame = RotatingFrame::new(Vec3::zeros(), Vec3::z(), 1.0);
+        let wall = Wall {
+            name: "b".into(),
+            species: SpeciesId(0),
+            shape: WallShape::Baffle { frame, start_m: [0.5, 0.0], end_m: [1.0, 0.0], half_thickness_m: 0.01 },
+        };
+        // At angle 0 the plate lies on +x; a point above it at (0.75, 0.1).
+        let p0 = wall.proximity(&Vec3::new(0.75, 0.1, 0.0), 0.0);
+        assert!((p0.gap_m - 0.09).abs() < 1e-12);
+        // After a quarter turn the plate lies on +y; the same distance is now along −x.
+        let p1 = wall.proximity(&Vec3::new(-0.1, 0.75, 0.0), std::f64::consts::FRAC_PI_2);
+        assert!((p1.gap_m - 0.09).abs() < 1e-12);
+        assert!((p1.normal - Vec3::new(-1.0, 0.0, 0.0)).norm() < 1e-12);
+        // Contact point (−0.01, 0.75): Ω ẑ × r = (−0.75, −0.01).
+        assert!((p1.wall_velocity - Vec3::new(-0.75, -0.01, 0.0)).norm() < 1e-9);
+    }
+}

@@ -1,0 +1,21 @@
+//! The simulation engine: soft-sphere DEM (this issue), with the gas phase, cohesion, heat and mass transfer to
+//! join. It knows nothing about campaigns; `Simulation` is driven by `crate::run` (the `simulate` command) and,
+//! later, by workers.
+
+pub mod contacts;
+pub mod error;
+pub mod forces;
+pub mod geometry;
+pub mod integrate;
+pub mod models;
+pub mod neighbor;
+pub mod particles;
+pub mod simulation;
+pub mod state;
+
+/// Three-vector of f64 used everywhere in the engine.
+pub type Vec3 = nalgebra::Vector3<f64>;
+
+pub use error::NumericalError;
+pub use simulation::{SimConfig, Simulation};
+pub use state::SimState;

@@ -1,0 +1,81 @@
+//! A contact law = its slots (normal, tangential, optional rolling), chosen by name, and the one kernel that
+//! composes them for a single contact.
+//!
+//! The composition passes values explicitly: the normal slot's force and contact radius go to the tangential and
+//! rolling slots. Lever arms and torques are formed by the caller (`forces.rs`), which also owns the geometry.
+
+use serde::{Deserialize, Serialize};
+
+use super::history::ContactHistory;
+use super::normal::NormalModel;
+use super::pair_table::PairMaterial;
+use super::rolling::RollingModel;
+use super::tangential::TangentialModel;
+use crate::engine::Vec3;
+
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ContactLaw {
+    pub normal: NormalModel,
+    pub tangential: TangentialModel,
+    #[serde(default)]
+    pub rolling: RollingModel,
+}
+
+/// Geometry and kinematics of one contact, as seen from particle i.
+#[derive(Debug, Clone, Copy)]
+pub struct ContactKinematics {
+    /// Unit normal pointing from the partner (j or the wall) to i.
+    pub normal: Vec3,
+    pub overlap_m: f64,
+    pub effective_radius_m: f64,
+    pub effective_mass_kg: f64,
+    /// Velocity of i's contact point minus that of the partner's contact point.
+    pub contact_velocity: Vec3,
+    /// ω_i − ω_j (for a wall, ω_i minus the wall's own rotation).
+    pub relative_angular_velocity: Vec3,
+}
+
+/// What one contact exerts on particle i (the partner receives the opposite force).
+#[derive(Debug, Clone, Copy)]
+pub struct ContactOutput {
+    /// Total contact force on i.
+    pub force: Vec3,
+    /// Its tangential part, for the torques −R n × F_t.
+    pub tangential_force: Vec3,
+    /// Rolling-resistance torque on i (the partner receives the opposite).
+    pub rolling_torque: Vec3,
+}
+
+impl ContactLaw {
+    /// Names of the slot models, as stored in checkpoints and results.
+    pub fn model_names(&self) -> [&'static str; 3] {
+        [self.normal.name(), self.tangential.name(), self.rolling.name()]
+    }
+
+    /// Evaluates one overlapping contact and updates its history.
+    #[inline]
+    pub fn evaluate(&self, mat: &PairMaterial, k: &ContactKinematics, dt_s: f64, hist: &mut ContactHistory) -> ContactOutput {
+        let n = k.normal;
+        let vn = k.contact_velocity.dot(&n);
+        let normal = self
+            .normal
+            .force(mat, k.effective_radius_m, k.effective_mass_kg, k.overlap_m, vn, hist);
+        let vt = k.contact_velocity - n * vn;
+        let ft = self
+            .tangential
+            .force(&self.normal, mat, k.effective_mass_kg, &normal, &n, &vt, dt_s, hist);
+        let rolling_torque = self.rolling.torque(
+            mat.rolling_friction_coefficient,
+            k.effective_radius_m,
+            normal.force_n,
+            &k.relative_angular_velocity,
+        );
+        hist.active = true;
+        ContactOutput {
+            force: n * normal.force_n + ft,
+            tangential_force: ft,
+            rolling_torque,
+        }
+    }
+}

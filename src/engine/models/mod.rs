@@ -1,0 +1,16 @@
+//! Contact models: each slot is a closed enum of named variants with typed parameters and pure kernels, tested
+//! beside them. Cohesion, liquid bridges, drag, heat and mass transfer join here in later issues.
+
+pub mod contact_law;
+pub mod history;
+pub mod normal;
+pub mod pair_table;
+pub mod rolling;
+pub mod tangential;
+
+pub use contact_law::{ContactKinematics, ContactLaw, ContactOutput};
+pub use history::ContactHistory;
+pub use normal::{NormalModel, PlasticSlope};
+pub use pair_table::{PairMaterial, PairTable};
+pub use rolling::RollingModel;
+pub use tangential::TangentialModel;

@@ -1,0 +1,371 @@
+//! `Simulation`: the configuration (immutable during a run), the state, and the workspace; `step()` advances one
+//! DEM time step.
+//!
+//! A step is velocity Verlet: half kick with the forces of the previous step, drift, wall rotation, neighbour-list
+//! refresh if needed, contact forces, half kick, then the numerical checks (non-finite values, lost particles,
+//! excessive overlap), each reported as a [`NumericalError`] naming the step and particle.
+
+use std::sync::Arc;
+use std::time::{Duration, Instant};
+
+use super::contacts::AlignedHistory;
+use super::forces::{PairBuffers, compute_contact_forces};
+use super::geometry::{Domain, Gravity, Wall};
+use super::integrate::{drift, half_kick};
+use super::models::{ContactLaw, PairTable};
+use super::neighbor::NeighborList;
+use super::particles::{ParticleId, Particles, SpeciesTable};
+use super::state::{RngState, SimState};
+use super::{NumericalError, Vec3};
+
+/// Everything about a simulation that does not change while it runs.
+#[derive(Debug, Clone)]
+pub struct SimConfig {
+    pub domain: Domain,
+    /// One particle layer moving in x–y only (seeds' 2-D beds and kilns): z velocity, z force and x/y rotation are
+    /// held at zero.
+    pub pseudo_2d: bool,
+    pub gravity: Gravity,
+    pub species: SpeciesTable,
+    pub pair_table: PairTable,
+    pub contact_law: ContactLaw,
+    pub walls: Vec<Wall>,
+    /// Neighbour-list skin: candidates are pairs whose surfaces are closer than this.
+    pub skin_m: f64,
+    /// Largest tolerated overlap as a fraction of the smaller radius; beyond it the step fails.
+    pub max_overlap_fraction: f64,
+}
+
+/// Wall-clock time spent per stage.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct StageTimers {
+    pub neighbor: Duration,
+    pub force: Duration,
+    pub integrate: Duration,
+}
+
+pub struct Simulation {
+    pub config: Arc<SimConfig>,
+    pub particles: Particles,
+    pub step: u64,
+    pub time_s: f64,
+    pub dt_s: f64,
+    pub wall_angle_rad: Vec<f64>,
+    pub rng: RngState,
+    list: NeighborList,
+    history: AlignedHistory,
+    buffers: PairBuffers,
+    pool: Arc<rayon::ThreadPool>,
+    pub timers: StageTimers,
+}
+
+impl Simulation {
+    /// A new simulation at t = 0 with `particles` as placed; computes the initial contact forces.
+    pub fn new(
+        config: Arc<SimConfig>,
+        particles: Particles,
+        dt_s: f64,
+        rng: RngState,
+        threads: usize,
+    ) -> Result<Self, NumericalError> {
+        let n_walls = config.walls.len();
+        let mut sim = Simulation {
+            config,
+            particles,
+            step: 0,
+            time_s: 0.0,
+            dt_s,
+            wall_angle_rad: vec![0.0; n_walls],
+            rng,
+            list: NeighborList::default(),
+            history: AlignedHistory::default(),
+            buffers: PairBuffers::default(),
+            pool: make_pool(threads),
+            timers: StageTimers::default(),
+        };
+        sim.refresh_neighbors(true);
+        // The first half kick needs F(0). With dt = 0 the tangential springs do not move.
+        let worst = sim.with_pool(|s| s.forces(0.0));
+        sim.check_overlap(worst)?;
+        Ok(sim)
+    }
+
+    /// Resumes from a checkpointed state; the next `step()` continues exactly where the saved run was.
+    pub fn restore(config: Arc<SimConfig>, state: SimState, threads: usize) -> Result<Self, NumericalError> {
+        let mut sim = Simulation {
+            config,
+            particles: state.particles,
+            step: state.step,
+            time_s: state.time_s,
+            dt_s: state.dt_s,
+            wall_angle_rad: state.wall_angle_rad,
+            rng: state.rng,
+            list: NeighborList::default(),
+            history: AlignedHistory::default(),
+            buffers: PairBuffers::default(),
+            pool: make_pool(threads),
+            timers: StageTimers::default(),
+        };
+        sim.list.build(
+            &sim.config.domain,
+            &sim.particles.position_m,
+            &sim.particles.radius_m,
+            sim.config.skin_m,
+            &sim.config.walls,
+            &sim.wall_angle_rad,
+        );
+        let (history, orphans) = AlignedHistory::from_store(&state.contacts, &sim.list);
+        if orphans > 0 {
+            return Err(NumericalError::OrphanContacts { count: orphans });
+        }
+        sim.history = history;
+        Ok(sim)
+    }
+
+    /// The complete state, for checkpoints and comparisons.
+    pub fn snapshot(&self) -> SimState {
+        SimState {
+            step: self.step,
+            time_s: self.time_s,
+            dt_s: self.dt_s,
+            particles: self.particles.clone(),
+            wall_angle_rad: self.wall_angle_rad.clone(),
+            contacts: self.history.to_store(&self.list),
+            rng: self.rng,
+        }
+    }
+
+    pub fn threads(&self) -> usize {
+        self.pool.current_num_threads()
+    }
+
+    pub fn neighbor_builds(&self) -> u64 {
+        self.list.builds
+    }
+
+    /// Number of active particle–particle and particle–wall contacts.
+    pub fn contact_counts(&self) -> (usize, usize) {
+        (
+            self.history.pair.iter().filter(|h| h.active).count(),
+            self.history.wall.iter().filter(|h| h.active).count(),
+        )
+    }
+
+    /// Per-particle coordination number (particle–particle contacts only).
+    pub fn coordination_numbers(&self) -> Vec<u32> {
+        let mut z = vec![0u32; self.particles.len()];
+        for i in 0..self.particles.len() {
+            for k in self.list.pairs_of(i) {
+                if self.history.pair[k].active {
+                    z[i] += 1;
+                    z[self.list.partner[k] as usize] += 1;
+                }
+            }
+        }
+        z
+    }
+
+    /// Approximate heap bytes of state and workspace.
+    pub fn heap_bytes(&self) -> usize {
+        self.particles.heap_bytes() + self.list.heap_bytes() + self.history.heap_bytes() + self.buffers.heap_bytes()
+    }
+
+    /// Advances `n` steps.
+    pub fn run_steps(&mut self, n: u64) -> Result<(), NumericalError> {
+        for _ in 0..n {
+            self.step()?;
+        }
+        Ok(())
+    }
+
+    /// Advances one time step.
+    pub fn step(&mut self) -> Result<(), NumericalError> {
+        self.with_pool(|s| s.step_inner())
+    }
+
+    fn step_inner(&mut self) -> Result<(), NumericalError> {
+        let dt = self.dt_s;
+        let config = Arc::clone(&self.config);
+        let t0 = Instant::now();
+        let g0 = config.gravity.at(self.time_s);
+        if let Some(i) = half_kick(&mut self.particles, &g0, dt, config.pseudo_2d) {
+            return Err(self.non_finite(i));
+        }
+        let lost_tolerance = self.particles.max_radius_m();
+        if let Some(i) = drift(&mut self.particles, &config.domain, dt, lost_tolerance) {
+            let x = self.particles.position_m[i];
+            return Err(if x.iter().all(|a| a.is_finite()) {
+                NumericalError::ParticleLost {
+                    step: self.step + 1,
+                    particle: ParticleId(i as u32),
+                    position_m: x,
+                }
+            } else {
+                NumericalError::NonFinite {
+                    step: self.step + 1,
+                    particle: ParticleId(i as u32),
+                    field: "position",
+                }
+            });
+        }
+        for (angle, wall) in self.wall_angle_rad.iter_mut().zip(&config.walls) {
+            *angle += wall.angular_velocity_rad_per_s() * dt;
+        }
+        self.step += 1;
+        self.time_s += dt;
+        let t1 = Instant::now();
+        self.refresh_neighbors(false);
+        let t2 = Instant::now();
+        let worst = self.forces(dt);
+        let t3 = Instant::now();
+        let g1 = config.gravity.at(self.time_s);
+        if let Some(i) = half_kick(&mut self.particles, &g1, dt, config.pseudo_2d) {
+            return Err(self.non_finite(i));
+        }
+        let t4 = Instant::now();
+        self.timers.integrate += (t1 - t0) + (t4 - t3);
+        self.timers.neighbor += t2 - t1;
+        self.timers.force += t3 - t2;
+        self.check_overlap(worst)
+    }
+
+    fn non_finite(&self, i: usize) -> NumericalError {
+        let p = &self.particles;
+        let field = if !p.force_n[i].iter().all(|a| a.is_finite()) {
+            "force"
+        } else if !p.torque_n_m[i].iter().all(|a| a.is_finite()) {
+            "torque"
+        } else if !p.velocity_m_per_s[i].iter().all(|a| a.is_finite()) {
+            "velocity"
+        } else {
+            "angular velocity"
+        };
+        NumericalError::NonFinite {
+            step: self.step,
+            particle: ParticleId(i as u32),
+            field,
+        }
+    }
+
+    fn check_overlap(&self, worst: super::forces::WorstOverlap) -> Result<(), NumericalError> {
+        if worst.ratio > self.config.max_overlap_fraction {
+            return Err(NumericalError::ExcessiveOverlap {
+                step: self.step,
+                particle: ParticleId(worst.particle),
+                partner: worst.partner_name(&self.config.walls),
+                overlap_m: worst.overlap_m,
+                ratio: worst.ratio,
+                limit: self.config.max_overlap_fraction,
+            });
+        }
+        Ok(())
+    }
+
+    fn forces(&mut self, dt: f64) -> super::forces::WorstOverlap {
+        let threads = self.threads();
+        compute_contact_forces(
+            &self.config,
+            &mut self.particles,
+            &self.wall_angle_rad,
+            dt,
+            &self.list,
+            &mut self.history,
+            &mut self.buffers,
+            threads,
+        )
+    }
+
+    fn refresh_neighbors(&mut self, force: bool) {
+        let c = &self.config;
+        if !force && !self.list.needs_rebuild(&c.domain, &self.particles.position_m, &c.walls, &self.wall_angle_rad) {
+            return;
+        }
+        let store = self.history.to_store(&self.list);
+        self.list.build(
+            &c.domain,
+            &self.particles.position_m,
+            &self.particles.radius_m,
+            c.skin_m,
+            &c.walls,
+            &self.wall_angle_rad,
+        );
+        let (history, orphans) = AlignedHistory::from_store(&store, &self.list);
+        // A contact is always a candidate of a list built from the same positions.
+        debug_assert_eq!(orphans, 0, "contacts lost in a neighbour-list rebuild");
+        self.history = history;
+    }
+
+    fn with_pool<R: Send>(&mut self, f: impl FnOnce(&mut Self) -> R + Send) -> R {
+        let pool = Arc::clone(&self.pool);
+        pool.install(|| f(self))
+    }
+
+    /// Elastic energy stored in the active contacts, J: (8/15) E* √R* δ^{5/2} for Hertzian contacts that have not
+    /// yielded, ½ K δ² for the linear spring. Tangential springs are not counted (zero for frictionless runs).
+    pub fn elastic_energy_j(&self) -> f64 {
+        use super::models::NormalModel;
+        let c = &self.config;
+        let p = &self.particles;
+        let potential = |mat: &super::models::PairMaterial, r_star: f64, overlap: f64| match c.contact_law.normal {
+            NormalModel::LinearSpringDashpot { stiffness_n_per_m, .. } => 0.5 * stiffness_n_per_m * overlap * overlap,
+            NormalModel::Hertz { .. } | NormalModel::Thornton { .. } => {
+                8.0 / 15.0 * mat.effective_youngs_modulus_pa * r_star.sqrt() * overlap.powf(2.5)
+            }
+        };
+        let mut e = 0.0;
+        for i in 0..p.len() {
+            for k in self.list.pairs_of(i) {
+                let j = self.list.partner[k] as usize;
+                let d = c.domain.separation(&p.position_m[i], &p.position_m[j]).norm();
+                let overlap = p.radius_m[i] + p.radius_m[j] - d;
+                if overlap > 0.0 {
+                    let r_star = p.radius_m[i] * p.radius_m[j] / (p.radius_m[i] + p.radius_m[j]);
+                    e += potential(c.pair_table.get(p.species[i], p.species[j]), r_star, overlap);
+                }
+            }
+            for k in self.list.walls_of(i) {
+                let w = self.list.wall_partner[k] as usize;
+                let wall = &c.walls[w];
+                let overlap = p.radius_m[i] - wall.proximity(&p.position_m[i], self.wall_angle_rad[w]).gap_m;
+                if overlap > 0.0 {
+                    e += potential(c.pair_table.get(p.species[i], wall.species), p.radius_m[i], overlap);
+                }
+            }
+        }
+        e
+    }
+
+    /// Kinetic energy (translational + rotational) and gravitational potential energy relative to the origin.
+    pub fn mechanical_energy_j(&self) -> (f64, f64) {
+        let g = self.config.gravity.at(self.time_s);
+        let p = &self.particles;
+        let potential: f64 = (0..p.len()).map(|i| -p.mass_kg[i] * g.dot(&p.position_m[i])).sum();
+        (p.kinetic_energy_j(), potential)
+    }
+
+    /// Height of the bed along −g: the highest particle top, and the mean centre height, in m.
+    pub fn bed_height_m(&self) -> (f64, f64) {
+        let g = self.config.gravity.at(self.time_s);
+        let up = if g.norm() > 0.0 { -g.normalize() } else { Vec3::z() };
+        let p = &self.particles;
+        let mut top = f64::NEG_INFINITY;
+        let mut sum = 0.0;
+        for i in 0..p.len() {
+            let h = p.position_m[i].dot(&up);
+            top = top.max(h + p.radius_m[i]);
+            sum += h;
+        }
+        (top, sum / p.len().max(1) as f64)
+    }
+}
+
+/// Every simulation runs in its own pool, so that "one thread" really is one (rayon's global pool would use every
+/// core for the per-particle loops).
+fn make_pool(threads: usize) -> Arc<rayon::ThreadPool> {
+    Arc::new(
+        rayon::ThreadPoolBuilder::new()
+            .num_threads(threads.max(1))
+            .build()
+            .expect("a rayon pool of a few threads can always be built"),
+    )
+}

@@ -1,0 +1,61 @@
+//! The one error type of granflow and its mapping to process exit codes.
+//!
+//! Each subsystem has its own `thiserror` enum (scenario configuration, numerical failure, checkpoint I/O); this
+//! module wraps them so that `main.rs` can map any failure to a documented exit code in one place. Messages are
+//! lowercase fragments that read well after "failed to" and name the file, key, step or particle involved.
+
+use std::path::PathBuf;
+
+use crate::checkpoint::CheckpointError;
+use crate::engine::NumericalError;
+use crate::scenario::ConfigError;
+
+/// Exit code for invalid input (configuration, YAML, CLI arguments), checked before anything is written.
+pub const EXIT_CONFIG: i32 = 2;
+/// Exit code for a numerical failure of the simulation (non-finite values, excessive overlap, lost particle).
+pub const EXIT_NUMERICAL: i32 = 3;
+/// Exit code for an unreadable, corrupt or unwritable checkpoint.
+pub const EXIT_CHECKPOINT: i32 = 4;
+/// Exit code for other I/O failures and failures of external programs (e.g. LIGGGHTS in `bench`).
+pub const EXIT_IO: i32 = 5;
+
+#[derive(Debug, thiserror::Error)]
+pub enum Error {
+    #[error(transparent)]
+    Config(#[from] ConfigError),
+    #[error(transparent)]
+    Numerical(#[from] NumericalError),
+    #[error(transparent)]
+    Checkpoint(#[from] CheckpointError),
+    #[error("{action} {path}: {source}")]
+    Io {
+        action: &'static str,
+        path: PathBuf,
+        #[source]
+        source: std::io::Error,
+    },
+    #[error("{0}")]
+    External(String),
+}
+
+impl Error {
+    /// The process exit code for this error (see the `EXIT_*` constants).
+    pub fn exit_code(&self) -> i32 {
+        match self {
+            Error::Config(_) => EXIT_CONFIG,
+            Error::Numerical(_) => EXIT_NUMERICAL,
+            Error::Checkpoint(_) => EXIT_CHECKPOINT,
+            Error::Io { .. } | Error::External(_) => EXIT_IO,
+        }
+    }
+
+    pub fn io(action: &'static str, path: impl Into<PathBuf>, source: std::io::Error) -> Self {
+        Error::Io {
+            action,
+            path: path.into(),
+            source,
+        }
+    }
+}
+
+pub type Result<T, E = Error> = std::result::Result<T, E>;

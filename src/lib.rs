@@ -1,0 +1,16 @@
+//! granflow: campaigns of coupled soft-sphere DEM + gas-phase simulations for particle-process engineering.
+//!
+//! This crate is the library behind the `granflow` binary. The engine (`engine`) knows nothing about campaigns;
+//! `scenario` turns a YAML description of one simulation into the engine's configuration; `checkpoint` writes and
+//! verifies complete HDF5 states; `simulate` and `bench` are the commands built on them.
+
+pub mod bench;
+pub mod checkpoint;
+pub mod cli;
+pub mod engine;
+pub mod error;
+mod models_doc;
+pub mod scenario;
+pub mod simulate;
+
+pub use error::{Error, Result};

@@ -1,0 +1,29 @@
+//! The text of `granflow models`: every model name a scenario can use, with its parameters and units. Kept next to
+//! the enums it describes by a test that parses every example below.
+
+pub const MODELS: &str = r#"contact.normal (one of):
+  linear_spring_dashpot: { stiffness_n_per_m, damping_kg_per_s }       seed 001 eq. 6.16, seed 002 eq. 21
+  hertz: { restitution }                                                 Hertz + Tsuji viscoelastic damping (LIGGGHTS)
+  thornton: { plastic_slope: continuous | seed_printed }                 seed 000 eqs. 2.3-2.9; species.yield_force_n
+contact.tangential (one of):
+  linear_spring_coulomb: { stiffness_n_per_m, damping_kg_per_s }       seed 001 eqs. 6.20-6.24, seed 002 eq. 22
+  mindlin                                                                k_t = 8 G* a, LIGGGHTS tangential history
+  walton_braun: { exponent }                                             seed 000 eqs. 2.10-2.13 (exponent default 1/3)
+contact.rolling (optional, default none):
+  none
+  constant_directional_torque                                            M = mu_r R* F_n; species.rolling_friction_coefficient
+species: { name, radius_m, density_kg_per_m3, youngs_modulus_pa, poisson_ratio, friction_coefficient,
+           yield_force_n?, rolling_friction_coefficient?, thermal_conductivity_w_per_m_k?, heat_capacity_j_per_kg_k? }
+walls (list of):
+  box: { species }                                                       planes on every non-periodic face
+  plane: { name, species, point_m, normal }
+  drum: { name, species, axis_point_m, axis, radius_m, rotation_rpm, baffles: [...] }
+    baffles: traditional: { count, length_m, half_thickness_m, tilt_deg }
+             axial: { count, length_m, half_thickness_m, inner_radius_m }
+             segment: { start_m, end_m, half_thickness_m }
+gravity: { vector_m_per_s2, flip?: { axis: x|y|z, frequency_hz } }       flip: seed 000 zig-zag chute
+fill (list of):
+  lattice: { species, spacing_m, lo_m, hi_m, origin_m?, inside_drum? }
+  random: { species, count, lo_m, hi_m, inside_drum? }
+time: { end_time_s, dt_s | dt_fraction_of_contact_time, reference_velocity_m_per_s? }
+"#;

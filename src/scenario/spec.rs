@@ -1,0 +1,207 @@
+//! The scenario file as the user writes it (YAML, serde, unknown keys rejected). Units are SI with suffixes, except
+//! the few non-SI conveniences (`rotation_rpm`, `tilt_deg`) that `build.rs` converts in one place.
+
+use serde::{Deserialize, Serialize};
+
+use crate::engine::geometry::Gravity;
+use crate::engine::models::ContactLaw;
+use crate::engine::particles::Species;
+
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ScenarioSpec {
+    pub name: String,
+    pub domain: DomainSpec,
+    /// One particle layer, motion in x–y only.
+    #[serde(default)]
+    pub pseudo_2d: bool,
+    pub gravity: Gravity,
+    pub species: Vec<Species>,
+    pub contact: ContactLaw,
+    #[serde(default)]
+    pub walls: Vec<WallSpec>,
+    pub fill: Vec<FillSpec>,
+    pub time: TimeSpec,
+    #[serde(default)]
+    pub neighbor: NeighborSpec,
+    #[serde(default)]
+    pub output: OutputSpec,
+    /// Seed of the random generator (random fills; later: spray).
+    #[serde(default)]
+    pub seed: u64,
+    /// Largest tolerated overlap as a fraction of the smaller radius before the run fails as numerically unstable.
+    #[serde(default = "default_max_overlap_fraction")]
+    pub max_overlap_fraction: f64,
+}
+
+fn default_max_overlap_fraction() -> f64 {
+    // CHOICE: 0.25 of the smaller radius. Soft-sphere results are meaningless well before this (typical
+    // overlaps are 0.1–1 %), so reaching it means the time step or stiffness is wrong, not that the bed is dense.
+    0.25
+}
+
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct DomainSpec {
+    pub lo_m: [f64; 3],
+    pub hi_m: [f64; 3],
+    #[serde(default)]
+    pub periodic: [bool; 3],
+}
+
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case", deny_unknown_fields)]
+pub enum WallSpec {
+    /// Plane walls on the faces of the domain along every non-periodic axis.
+    Box { species: String },
+    Plane {
+        name: String,
+        species: String,
+        point_m: [f64; 3],
+        /// Points into the particle side; normalised on load.
+        normal: [f64; 3],
+    },
+    /// Inside of a rotating cylinder, with baffles turning with it.
+    Drum(DrumSpec),
+}
+
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct DrumSpec {
+    pub name: String,
+    pub species: String,
+    pub axis_point_m: [f64; 3],
+    pub axis: [f64; 3],
+    pub radius_m: f64,
+    /// Rotation speed about `axis` (right-handed), revolutions per minute.
+    pub rotation_rpm: f64,
+    #[serde(default)]
+    pub baffles: Vec<BaffleSpec>,
+}
+
+/// Baffle plates fixed to a drum (seed 000 §3.4, Fig. 23). Coordinates are in the plane normal to the drum axis,
+/// relative to the axis, at drum angle 0.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case", deny_unknown_fields)]
+pub enum BaffleSpec {
+    /// `count` plates attached to the wall at equal angles, reaching `length_m` inwards; `tilt_deg` = 0 is a
+    /// straight (radial) baffle, otherwise the plate leans by that angle from the radial direction ("angled").
+    Traditional {
+        count: u32,
+        length_m: f64,
+        half_thickness_m: f64,
+        #[serde(default)]
+        tilt_deg: f64,
+    },
+    /// Plates near the axis, where the flowing layer is. One plate: a bar of `length_m` centred on the axis.
+    /// Several: spokes at equal angles from `inner_radius_m` to `inner_radius_m + length_m`.
+    Axial {
+        count: u32,
+        length_m: f64,
+        half_thickness_m: f64,
+        #[serde(default)]
+        inner_radius_m: f64,
+    },
+    /// Any plate, given by its mid-section segment.
+    Segment {
+        start_m: [f64; 2],
+        end_m: [f64; 2],
+        half_thickness_m: f64,
+    },
+}
+
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case", deny_unknown_fields)]
+pub enum FillSpec {
+    /// Particles on a simple-cubic lattice: points `origin_m + k·spacing_m` inside [lo_m, hi_m) (the LAMMPS
+    /// `lattice sc` + `create_atoms region` convention), optionally only those inside a drum.
+    Lattice {
+        species: String,
+        spacing_m: f64,
+        lo_m: [f64; 3],
+        hi_m: [f64; 3],
+        #[serde(default)]
+        origin_m: [f64; 3],
+        /// Keep only points whose particle fits inside this drum.
+        #[serde(default)]
+        inside_drum: Option<String>,
+    },
+    /// Particles at given positions, optionally with initial velocities and angular velocities.
+    Explicit {
+        species: String,
+        positions_m: Vec<[f64; 3]>,
+        #[serde(default)]
+        velocities_m_per_s: Vec<[f64; 3]>,
+        #[serde(default)]
+        angular_velocities_rad_per_s: Vec<[f64; 3]>,
+    },
+    /// `count` non-overlapping particles at random positions in [lo_m, hi_m] (random sequential insertion with the
+    /// scenario seed), optionally only inside a drum.
+    Random {
+        species: String,
+        count: u32,
+        lo_m: [f64; 3],
+        hi_m: [f64; 3],
+        #[serde(default)]
+        inside_drum: Option<String>,
+    },
+}
+
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct TimeSpec {
+    pub end_time_s: f64,
+    /// Fixed time step. Either this or `dt_fraction_of_contact_time`.
+    #[serde(default)]
+    pub dt_s: Option<f64>,
+    /// Time step as a fraction of the contact duration of the smallest particle pair at
+    /// `reference_velocity_m_per_s`.
+    #[serde(default)]
+    pub dt_fraction_of_contact_time: Option<f64>,
+    #[serde(default = "default_reference_velocity")]
+    pub reference_velocity_m_per_s: f64,
+}
+
+fn default_reference_velocity() -> f64 {
+    1.0
+}
+
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, Default)]
+#[serde(deny_unknown_fields)]
+pub struct NeighborSpec {
+    /// Neighbour-list skin. Default: 0.4 × the largest particle radius (0.6 mm for the 1.5 mm benchmark spheres,
+    /// as in its LIGGGHTS input).
+    #[serde(default)]
+    pub skin_m: Option<f64>,
+}
+
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct OutputSpec {
+    #[serde(default = "default_checkpoint_every")]
+    pub checkpoint_every_steps: u64,
+    #[serde(default = "default_keep")]
+    pub keep_checkpoints: usize,
+    #[serde(default = "default_series_every")]
+    pub series_every_steps: u64,
+}
+
+fn default_checkpoint_every() -> u64 {
+    10_000
+}
+fn default_keep() -> usize {
+    3
+}
+fn default_series_every() -> u64 {
+    1000
+}
+
+impl Default for OutputSpec {
+    fn default() -> Self {
+        OutputSpec {
+            checkpoint_every_steps: default_checkpoint_every(),
+            keep_checkpoints: default_keep(),
+            series_every_steps: default_series_every(),
+        }
+    }
+}

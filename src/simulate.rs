@@ -1,0 +1,234 @@
+//! `granflow simulate`: run one scenario to its end time in an output directory, with checkpoints and a time series,
+//! resuming from the newest valid checkpoint when the directory already holds a run of the same scenario.
+//!
+//! Directory layout: `scenario.json` (the resolved spec, written once), `ckpt-<step>.h5` (atomic, checksummed, the
+//! newest N kept), `series.csv` (one row per sample, rewritten up to the restored step on resume) and
+//! `summary.json` (written atomically at the end; its presence means the run finished).
+
+use std::io::Write;
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+use crate::checkpoint::{CheckpointMeta, CheckpointSeries};
+use crate::engine::Simulation;
+use crate::error::{Error, Result};
+use crate::scenario::{self, BuiltScenario};
+
+/// Options of one `simulate` invocation.
+#[derive(Debug, Clone)]
+pub struct SimulateOptions {
+    pub scenario_path: PathBuf,
+    pub out_dir: Option<PathBuf>,
+    pub threads: usize,
+    /// Stop after this many steps in this invocation (for tests of interrupted runs); the run stays resumable.
+    pub max_steps: Option<u64>,
+    pub quiet: bool,
+}
+
+/// What a finished (or stopped) invocation reports.
+#[derive(Debug, Clone, serde::Serialize)]
+pub struct Summary {
+    pub scenario: String,
+    pub particles: usize,
+    pub step: u64,
+    pub time_s: f64,
+    pub dt_s: f64,
+    pub dt_over_contact_time: f64,
+    pub finished: bool,
+    pub kinetic_energy_j: f64,
+    pub bed_top_m: f64,
+    pub mean_height_m: f64,
+    pub wall_time_s: f64,
+    pub steps_per_s: f64,
+    pub resumed_from_step: Option<u64>,
+}
+
+const SERIES_HEADER: &str =
+    "step,time_s,kinetic_energy_j,translational_kinetic_energy_j,bed_top_m,mean_height_m,pair_contacts,wall_contacts,mean_coordination";
+
+pub fn checkpoint_meta(built: &BuiltScenario) -> CheckpointMeta {
+    CheckpointMeta {
+        engine_version: env!("CARGO_PKG_VERSION").to_string(),
+        model_names: built.config.contact_law.model_names().iter().map(|s| s.to_string()).collect(),
+        wall_names: built.config.walls.iter().map(|w| w.name.clone()).collect(),
+        scenario_json: serde_json::to_string(&built.spec).expect("a validated spec always serialises"),
+    }
+}
+
+fn series_row(sim: &Simulation) -> String {
+    let (top, mean) = sim.bed_height_m();
+    let (pairs, walls) = sim.contact_counts();
+    let n = sim.particles.len().max(1) as f64;
+    format!(
+        "{},{:e},{:e},{:e},{:e},{:e},{},{},{:.6}",
+        sim.step,
+        sim.time_s,
+        sim.particles.kinetic_energy_j(),
+        sim.particles.translational_kinetic_energy_j(),
+        top,
+        mean,
+        pairs,
+        walls,
+        2.0 * pairs as f64 / n
+    )
+}
+
+/// Keeps the header and the rows up to `step` of an existing series file.
+fn truncate_series(path: &Path, step: u64) -> Result<()> {
+    let text = match std::fs::read_to_string(path) {
+        Ok(t) => t,
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => String::new(),
+        Err(e) => return Err(Error::io("read", path, e)),
+    };
+    let mut out = String::from(SERIES_HEADER);
+    out.push('\n');
+    for line in text.lines().skip(1) {
+        // A row cut short by a kill has fewer fields and is dropped.
+        let complete = line.split(',').count() == SERIES_HEADER.split(',').count();
+        match line.split(',').next().and_then(|s| s.parse::<u64>().ok()) {
+            Some(s) if s <= step && complete => {
+                out.push_str(line);
+                out.push('\n');
+            }
+            _ => {}
+        }
+    }
+    write_atomic(path, out.as_bytes())
+}
+
+/// Writes `bytes` to `path` through a temporary file and a rename.
+pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
+    let tmp = path.with_extension("tmp");
+    let mut f = std::fs::File::create(&tmp).map_err(|e| Error::io("create", &tmp, e))?;
+    f.write_all(bytes).map_err(|e| Error::io("write", &tmp, e))?;
+    f.sync_all().map_err(|e| Error::io("sync", &tmp, e))?;
+    std::fs::rename(&tmp, path).map_err(|e| Error::io("rename", path, e))
+}
+
+/// Runs (or resumes) a scenario. Returns the summary of this invocation.
+pub fn simulate(opts: &SimulateOptions) -> Result<Summary> {
+    let built = scenario::load(&opts.scenario_path)?;
+    let out = opts
+        .out_dir
+        .clone()
+        .unwrap_or_else(|| PathBuf::from("results").join(&built.spec.name));
+    let meta = checkpoint_meta(&built);
+    std::fs::create_dir_all(&out).map_err(|e| Error::io("create directory", &out, e))?;
+    let spec_path = out.join("scenario.json");
+    match std::fs::read_to_string(&spec_path) {
+        Ok(existing) if existing != meta.scenario_json => {
+            return Err(Error::External(format!(
+                "{} holds a run of a different scenario (its scenario.json differs); choose another --out",
+                out.display()
+            )));
+        }
+        Ok(_) => {}
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => write_atomic(&spec_path, meta.scenario_json.as_bytes())?,
+        Err(e) => return Err(Error::io("read", &spec_path, e)),
+    }
+
+    let series = CheckpointSeries::new(&out, built.spec.output.keep_checkpoints);
+    let series_path = out.join("series.csv");
+    let (mut sim, resumed_from_step) = match series.latest_valid()? {
+        Some(loaded) => {
+            for rejected in &loaded.rejected {
+                eprintln!("warning: {rejected}; using {} instead", loaded.path.display());
+            }
+            if loaded.meta.scenario_json != meta.scenario_json {
+                return Err(Error::External(format!(
+                    "checkpoint {} was written for a different scenario",
+                    loaded.path.display()
+                )));
+            }
+            let step = loaded.state.step;
+            truncate_series(&series_path, step)?;
+            if !opts.quiet {
+                eprintln!("resuming from {} (step {step})", loaded.path.display());
+            }
+            (Simulation::restore(built.config.clone(), loaded.state, opts.threads)?, Some(step))
+        }
+        None => {
+            let sim = Simulation::new(
+                built.config.clone(),
+                built.particles.clone(),
+                built.dt_s,
+                built.rng,
+                opts.threads,
+            )?;
+            truncate_series(&series_path, 0)?;
+            series.write(&sim.snapshot(), &meta)?;
+            let mut f = std::fs::OpenOptions::new()
+                .append(true)
+                .open(&series_path)
+                .map_err(|e| Error::io("open", &series_path, e))?;
+            writeln!(f, "{}", series_row(&sim)).map_err(|e| Error::io("write", &series_path, e))?;
+            (sim, None)
+        }
+    };
+
+    let total_steps = (built.spec.time.end_time_s / sim.dt_s).round() as u64;
+    let mut series_file = std::fs::OpenOptions::new()
+        .append(true)
+        .open(&series_path)
+        .map_err(|e| Error::io("open", &series_path, e))?;
+    let start = Instant::now();
+    let start_step = sim.step;
+    let mut last_report = Instant::now();
+    let stop_at = opts.max_steps.map_or(total_steps, |m| (start_step + m).min(total_steps));
+    if !opts.quiet && resumed_from_step.is_none() {
+        eprintln!(
+            "{}: {} particles, dt = {:.3e} s = {:.4} t_c, {} steps to t = {} s, {} thread(s)",
+            built.spec.name,
+            sim.particles.len(),
+            sim.dt_s,
+            sim.dt_s / built.contact_time_s,
+            total_steps,
+            built.spec.time.end_time_s,
+            sim.threads()
+        );
+    }
+    while sim.step < stop_at {
+        sim.step()?;
+        if sim.step % built.spec.output.series_every_steps == 0 {
+            writeln!(series_file, "{}", series_row(&sim)).map_err(|e| Error::io("write", &series_path, e))?;
+        }
+        if sim.step % built.spec.output.checkpoint_every_steps == 0 || sim.step == total_steps {
+            series_file.flush().map_err(|e| Error::io("write", &series_path, e))?;
+            series.write(&sim.snapshot(), &meta)?;
+        }
+        if !opts.quiet && last_report.elapsed().as_secs_f64() > 5.0 {
+            last_report = Instant::now();
+            let rate = (sim.step - start_step) as f64 / start.elapsed().as_secs_f64();
+            eprintln!(
+                "step {}/{} t = {:.4} s, {:.0} steps/s, KE = {:.3e} J",
+                sim.step,
+                total_steps,
+                sim.time_s,
+                rate,
+                sim.particles.kinetic_energy_j()
+            );
+        }
+    }
+    let wall = start.elapsed().as_secs_f64();
+    let (top, mean) = sim.bed_height_m();
+    let summary = Summary {
+        scenario: built.spec.name.clone(),
+        particles: sim.particles.len(),
+        step: sim.step,
+        time_s: sim.time_s,
+        dt_s: sim.dt_s,
+        dt_over_contact_time: sim.dt_s / built.contact_time_s,
+        finished: sim.step >= total_steps,
+        kinetic_energy_j: sim.particles.kinetic_energy_j(),
+        bed_top_m: top,
+        mean_height_m: mean,
+        wall_time_s: wall,
+        steps_per_s: (sim.step - start_step) as f64 / wall.max(1e-9),
+        resumed_from_step,
+    };
+    if summary.finished {
+        let json = serde_json::to_string_pretty(&summary).expect("summary serialises");
+        write_atomic(&out.join("summary.json"), json.as_bytes())?;
+    }
+    Ok(summary)
+}
