@@ -4,7 +4,8 @@
 use criterion::{Criterion, criterion_group, criterion_main};
 use granflow::engine::Vec3;
 use granflow::engine::models::{
-    ContactHistory, ContactKinematics, ContactLaw, NormalModel, PairMaterial, PlasticSlope, RollingModel, TangentialModel,
+    ContactHistory, ContactKinematics, ContactLaw, NormalModel, PairMaterial, PlasticSlope,
+    RollingModel, TangentialModel,
 };
 use std::hint::black_box;
 
@@ -25,9 +26,40 @@ fn kernels(c: &mut Criterion) {
         relative_angular_velocity: Vec3::new(0.1, 0.2, -0.3),
     };
     let laws = [
-        ("hertz_mindlin", ContactLaw { normal: NormalModel::Hertz { restitution: 0.9 }, tangential: TangentialModel::Mindlin, rolling: RollingModel::None }),
-        ("thornton_walton_braun", ContactLaw { normal: NormalModel::Thornton { plastic_slope: PlasticSlope::Continuous }, tangential: TangentialModel::WaltonBraun { exponent: 1.0 / 3.0 }, rolling: RollingModel::None }),
-        ("linear_coulomb", ContactLaw { normal: NormalModel::LinearSpringDashpot { stiffness_n_per_m: 800.0, damping_kg_per_s: 7.9e-4 }, tangential: TangentialModel::LinearSpringCoulomb { stiffness_n_per_m: 800.0, damping_kg_per_s: 7.9e-4 }, rolling: RollingModel::None }),
+        (
+            "hertz_mindlin",
+            ContactLaw {
+                normal: NormalModel::Hertz { restitution: 0.9 },
+                tangential: TangentialModel::Mindlin,
+                rolling: RollingModel::None,
+            },
+        ),
+        (
+            "thornton_walton_braun",
+            ContactLaw {
+                normal: NormalModel::Thornton {
+                    plastic_slope: PlasticSlope::Continuous,
+                },
+                tangential: TangentialModel::WaltonBraun {
+                    exponent: 1.0 / 3.0,
+                },
+                rolling: RollingModel::None,
+            },
+        ),
+        (
+            "linear_coulomb",
+            ContactLaw {
+                normal: NormalModel::LinearSpringDashpot {
+                    stiffness_n_per_m: 800.0,
+                    damping_kg_per_s: 7.9e-4,
+                },
+                tangential: TangentialModel::LinearSpringCoulomb {
+                    stiffness_n_per_m: 800.0,
+                    damping_kg_per_s: 7.9e-4,
+                },
+                rolling: RollingModel::None,
+            },
+        ),
     ];
     for (name, law) in laws {
         c.bench_function(&format!("contact/{name}"), |b| {

@@ -10,7 +10,11 @@ use crate::error::Result;
 use crate::simulate::{SimulateOptions, simulate};
 
 #[derive(Debug, Parser)]
-#[command(name = "granflow", version, about = "Coupled DEM + CFD campaigns for particle-process engineering")]
+#[command(
+    name = "granflow",
+    version,
+    about = "Coupled DEM + CFD campaigns for particle-process engineering"
+)]
 pub struct Cli {
     #[command(subcommand)]
     pub command: Command,
@@ -79,7 +83,10 @@ pub fn run(cli: Cli) -> Result<()> {
                 max_steps,
                 quiet,
             })?;
-            println!("{}", serde_json::to_string_pretty(&summary).expect("summary serialises"));
+            println!(
+                "{}",
+                serde_json::to_string_pretty(&summary).expect("summary serialises")
+            );
             Ok(())
         }
         Command::Bench {

@@ -43,15 +43,21 @@ pub struct Summary {
     pub resumed_from_step: Option<u64>,
 }
 
-const SERIES_HEADER: &str =
-    "step,time_s,kinetic_energy_j,translational_kinetic_energy_j,bed_top_m,mean_height_m,pair_contacts,wall_contacts,mean_coordination";
+const SERIES_HEADER: &str = "step,time_s,kinetic_energy_j,translational_kinetic_energy_j,bed_top_m,mean_height_m,pair_contacts,wall_contacts,mean_coordination";
 
 pub fn checkpoint_meta(built: &BuiltScenario) -> CheckpointMeta {
     CheckpointMeta {
         engine_version: env!("CARGO_PKG_VERSION").to_string(),
-        model_names: built.config.contact_law.model_names().iter().map(|s| s.to_string()).collect(),
+        model_names: built
+            .config
+            .contact_law
+            .model_names()
+            .iter()
+            .map(|s| s.to_string())
+            .collect(),
         wall_names: built.config.walls.iter().map(|w| w.name.clone()).collect(),
-        scenario_json: serde_json::to_string(&built.spec).expect("a validated spec always serialises"),
+        scenario_json: serde_json::to_string(&built.spec)
+            .expect("a validated spec always serialises"),
     }
 }
 
@@ -100,7 +106,8 @@ fn truncate_series(path: &Path, step: u64) -> Result<()> {
 pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
     let tmp = path.with_extension("tmp");
     let mut f = std::fs::File::create(&tmp).map_err(|e| Error::io("create", &tmp, e))?;
-    f.write_all(bytes).map_err(|e| Error::io("write", &tmp, e))?;
+    f.write_all(bytes)
+        .map_err(|e| Error::io("write", &tmp, e))?;
     f.sync_all().map_err(|e| Error::io("sync", &tmp, e))?;
     std::fs::rename(&tmp, path).map_err(|e| Error::io("rename", path, e))
 }
@@ -123,7 +130,9 @@ pub fn simulate(opts: &SimulateOptions) -> Result<Summary> {
             )));
         }
         Ok(_) => {}
-        Err(e) if e.kind() == std::io::ErrorKind::NotFound => write_atomic(&spec_path, meta.scenario_json.as_bytes())?,
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => {
+            write_atomic(&spec_path, meta.scenario_json.as_bytes())?
+        }
         Err(e) => return Err(Error::io("read", &spec_path, e)),
     }
 
@@ -132,7 +141,10 @@ pub fn simulate(opts: &SimulateOptions) -> Result<Summary> {
     let (mut sim, resumed_from_step) = match series.latest_valid()? {
         Some(loaded) => {
             for rejected in &loaded.rejected {
-                eprintln!("warning: {rejected}; using {} instead", loaded.path.display());
+                eprintln!(
+                    "warning: {rejected}; using {} instead",
+                    loaded.path.display()
+                );
             }
             if loaded.meta.scenario_json != meta.scenario_json {
                 return Err(Error::External(format!(
@@ -145,7 +157,10 @@ pub fn simulate(opts: &SimulateOptions) -> Result<Summary> {
             if !opts.quiet {
                 eprintln!("resuming from {} (step {step})", loaded.path.display());
             }
-            (Simulation::restore(built.config.clone(), loaded.state, opts.threads)?, Some(step))
+            (
+                Simulation::restore(built.config.clone(), loaded.state, opts.threads)?,
+                Some(step),
+            )
         }
         None => {
             let sim = Simulation::new(
@@ -174,7 +189,9 @@ pub fn simulate(opts: &SimulateOptions) -> Result<Summary> {
     let start = Instant::now();
     let start_step = sim.step;
     let mut last_report = Instant::now();
-    let stop_at = opts.max_steps.map_or(total_steps, |m| (start_step + m).min(total_steps));
+    let stop_at = opts
+        .max_steps
+        .map_or(total_steps, |m| (start_step + m).min(total_steps));
     if !opts.quiet && resumed_from_step.is_none() {
         eprintln!(
             "{}: {} particles, dt = {:.3e} s = {:.4} t_c, {} steps to t = {} s, {} thread(s)",
@@ -190,10 +207,13 @@ pub fn simulate(opts: &SimulateOptions) -> Result<Summary> {
     while sim.step < stop_at {
         sim.step()?;
         if sim.step % built.spec.output.series_every_steps == 0 {
-            writeln!(series_file, "{}", series_row(&sim)).map_err(|e| Error::io("write", &series_path, e))?;
+            writeln!(series_file, "{}", series_row(&sim))
+                .map_err(|e| Error::io("write", &series_path, e))?;
         }
         if sim.step % built.spec.output.checkpoint_every_steps == 0 || sim.step == total_steps {
-            series_file.flush().map_err(|e| Error::io("write", &series_path, e))?;
+            series_file
+                .flush()
+                .map_err(|e| Error::io("write", &series_path, e))?;
             series.write(&sim.snapshot(), &meta)?;
         }
         if !opts.quiet && last_report.elapsed().as_secs_f64() > 5.0 {
@@ -208,6 +228,13 @@ pub fn simulate(opts: &SimulateOptions) -> Result<Summary> {
                 sim.particles.kinetic_energy_j()
             );
         }
+    }
+    if sim.step % built.spec.output.checkpoint_every_steps != 0 && sim.step != total_steps {
+        // Stopped early (--max-steps): keep everything computed so far.
+        series_file
+            .flush()
+            .map_err(|e| Error::io("write", &series_path, e))?;
+        series.write(&sim.snapshot(), &meta)?;
     }
     let wall = start.elapsed().as_secs_f64();
     let (top, mean) = sim.bed_height_m();

@@ -6,7 +6,7 @@
 //! the length and xxh3-64 of the file bytes, checked before libhdf5 parses the file. A reader therefore gets exactly
 //! the state that was written or a [`CheckpointError`] naming the file; truncated, bit-flipped or foreign files are
 //! errors, never panics or crashes. The layout (names, element types, units, checksum order, seal) is documented in
-//! `schemas/checkpoint.md` and defined in [`layout`]. What does *not* live here: deciding when to checkpoint,
+//! `schemas/checkpoint.md` and defined in `layout.rs`. What does *not* live here: deciding when to checkpoint,
 //! checking that a restored state matches the scenario being resumed (the caller compares [`CheckpointMeta`]), and
 //! rebuilding the engine from a state (`engine::Simulation::restore`).
 
@@ -577,84 +577,13 @@ mod tests {
         }
     }
 
-    /// Compares two states bit for bit (f64 by `to_bits`) and names the first differing field.
-    fn state_diff(a: &SimState, b: &SimState) -> Result<(), String> {
-        let (pa, pb) = (&a.particles, &b.particles);
-        let checks: [(&str, bool); 16] = [
-            ("step", a.step != b.step),
-            ("time_s", a.time_s.to_bits() != b.time_s.to_bits()),
-            ("dt_s", a.dt_s.to_bits() != b.dt_s.to_bits()),
-            ("particles.id", pa.id != pb.id),
-            ("particles.species", pa.species != pb.species),
-            (
-                "particles.radius_m",
-                f64s_differ(&pa.radius_m, &pb.radius_m),
-            ),
-            ("particles.mass_kg", f64s_differ(&pa.mass_kg, &pb.mass_kg)),
-            (
-                "particles.inertia_kg_m2",
-                f64s_differ(&pa.inertia_kg_m2, &pb.inertia_kg_m2),
-            ),
-            (
-                "particles.position_m",
-                vecs_differ(&pa.position_m, &pb.position_m),
-            ),
-            (
-                "particles.velocity_m_per_s",
-                vecs_differ(&pa.velocity_m_per_s, &pb.velocity_m_per_s),
-            ),
-            (
-                "particles.angular_velocity_rad_per_s",
-                vecs_differ(
-                    &pa.angular_velocity_rad_per_s,
-                    &pb.angular_velocity_rad_per_s,
-                ),
-            ),
-            ("particles.force_n", vecs_differ(&pa.force_n, &pb.force_n)),
-            (
-                "particles.torque_n_m",
-                vecs_differ(&pa.torque_n_m, &pb.torque_n_m),
-            ),
-            (
-                "wall_angle_rad",
-                f64s_differ(&a.wall_angle_rad, &b.wall_angle_rad),
-            ),
-            ("rng", a.rng != b.rng),
-            (
-                "contacts (count)",
-                a.contacts.pairs.len() != b.contacts.pairs.len()
-                    || a.contacts.walls.len() != b.contacts.walls.len(),
-            ),
-        ];
-        if let Some((name, _)) = checks.iter().find(|(_, differs)| *differs) {
-            return Err(format!("field {name} differs"));
-        }
-        for (k, (x, y)) in a.contacts.pairs.iter().zip(&b.contacts.pairs).enumerate() {
-            if (x.0, x.1) != (y.0, y.1) {
-                return Err(format!("contacts.pairs[{k}] key differs"));
-            }
-            if let Some(f) = history_diff(&x.2, &y.2) {
-                return Err(format!("contacts.pairs[{k}].{f} differs"));
-            }
-        }
-        for (k, (x, y)) in a.contacts.walls.iter().zip(&b.contacts.walls).enumerate() {
-            if (x.0, x.1) != (y.0, y.1) {
-                return Err(format!("contacts.walls[{k}] key differs"));
-            }
-            if let Some(f) = history_diff(&x.2, &y.2) {
-                return Err(format!("contacts.walls[{k}].{f} differs"));
-            }
-        }
-        Ok(())
-    }
-
     fn round_trip(state: &SimState, meta: &CheckpointMeta) {
         let dir = tempfile::tempdir().expect("tempdir");
         let path = dir.path().join("ckpt-000000000001.h5");
         write_checkpoint(&path, state, meta).expect("write");
         assert!(!tmp_path(&path).exists(), "temporary file left behind");
         let (back, back_meta) = read_checkpoint(&path).expect("read");
-        if let Err(e) = state_diff(state, &back) {
+        if let Some(e) = crate::engine::state::first_difference(state, &back) {
             panic!("round trip changed the state: {e}");
         }
         assert_eq!(&back_meta, meta);
@@ -686,20 +615,16 @@ mod tests {
     }
 
     #[test]
-    fn state_diff_names_the_first_differing_field() {
+    fn first_difference_names_the_first_differing_field() {
         let a = sample_state();
         let mut b = a.clone();
         b.particles.velocity_m_per_s[0].x = 0.0; // was -0.0: equal as numbers, different bits
-        assert_eq!(
-            state_diff(&a, &b),
-            Err("field particles.velocity_m_per_s differs".to_string())
-        );
+        let diff = crate::engine::state::first_difference(&a, &b).expect("differs");
+        assert!(diff.starts_with("particles.velocity_m_per_s[0].x"), "{diff}");
         let mut c = a.clone();
         c.contacts.walls[1].2.max_overlap_m += 1e-20;
-        assert_eq!(
-            state_diff(&a, &c),
-            Err("contacts.walls[1].max_overlap_m differs".to_string())
-        );
+        let diff = crate::engine::state::first_difference(&a, &c).expect("differs");
+        assert!(diff.starts_with("contacts.walls[1]") && diff.contains("max_overlap_m"), "{diff}");
     }
 
     #[test]
@@ -1109,7 +1034,9 @@ mod tests {
         );
         ds(&mut b, "particles/force_n", &[n, 3], &v3(&p.force_n));
         ds(&mut b, "particles/torque_n_m", &[n, 3], &v3(&p.torque_n_m));
-        let tables: [(&str, Vec<u8>, Vec<u8>, Vec<ContactHistory>); 2] = [
+        // (group, i bytes, partner bytes, histories)
+        type Table = (&'static str, Vec<u8>, Vec<u8>, Vec<ContactHistory>);
+        let tables: [Table; 2] = [
             (
                 "pairs",
                 state

@@ -47,16 +47,20 @@ impl AlignedHistory {
         for i in 0..n {
             for k in list.pairs_of(i) {
                 if self.pair[k].active {
-                    store
-                        .pairs
-                        .push((ParticleId(i as u32), ParticleId(list.partner[k]), self.pair[k]));
+                    store.pairs.push((
+                        ParticleId(i as u32),
+                        ParticleId(list.partner[k]),
+                        self.pair[k],
+                    ));
                 }
             }
             for k in list.walls_of(i) {
                 if self.wall[k].active {
-                    store
-                        .walls
-                        .push((ParticleId(i as u32), WallId(list.wall_partner[k]), self.wall[k]));
+                    store.walls.push((
+                        ParticleId(i as u32),
+                        WallId(list.wall_partner[k]),
+                        self.wall[k],
+                    ));
                 }
             }
         }
@@ -77,7 +81,10 @@ impl AlignedHistory {
             let slots = list.pairs_of(i);
             let partners = &list.partner[slots.clone()];
             while let Some((pi, pj, h)) = next_pair.next_if(|(pi, _, _)| pi.index() <= i) {
-                match (pi.index() == i).then(|| partners.binary_search(&pj.0)).and_then(Result::ok) {
+                match (pi.index() == i)
+                    .then(|| partners.binary_search(&pj.0))
+                    .and_then(Result::ok)
+                {
                     Some(offset) => pair[slots.start + offset] = *h,
                     None => orphans += 1,
                 }
@@ -85,7 +92,10 @@ impl AlignedHistory {
             let slots = list.walls_of(i);
             let partners = &list.wall_partner[slots.clone()];
             while let Some((pi, w, h)) = next_wall.next_if(|(pi, _, _)| pi.index() <= i) {
-                match (pi.index() == i).then(|| partners.binary_search(&w.0)).and_then(Result::ok) {
+                match (pi.index() == i)
+                    .then(|| partners.binary_search(&w.0))
+                    .and_then(Result::ok)
+                {
                     Some(offset) => wall[slots.start + offset] = *h,
                     None => orphans += 1,
                 }

@@ -67,7 +67,8 @@ impl WorstOverlap {
 
     fn max(self, other: WorstOverlap) -> WorstOverlap {
         // Ties resolve to the lower particle index so the report does not depend on the thread count.
-        if other.ratio > self.ratio || (other.ratio == self.ratio && other.particle < self.particle) {
+        if other.ratio > self.ratio || (other.ratio == self.ratio && other.particle < self.particle)
+        {
             other
         } else {
             self
@@ -104,9 +105,18 @@ struct PairResult {
 impl Context<'_> {
     /// Evaluates the pair (i, j) if it overlaps; otherwise clears its history.
     #[inline(always)]
-    fn pair(&self, i: usize, j: usize, hist: &mut ContactHistory, worst: &mut WorstOverlap) -> Option<PairResult> {
+    fn pair(
+        &self,
+        i: usize,
+        j: usize,
+        hist: &mut ContactHistory,
+        worst: &mut WorstOverlap,
+    ) -> Option<PairResult> {
         let p = self.p;
-        let d = self.config.domain.separation(&p.position_m[i], &p.position_m[j]);
+        let d = self
+            .config
+            .domain
+            .separation(&p.position_m[i], &p.position_m[j]);
         let dist2 = d.norm_squared();
         let (ri, rj) = (p.radius_m[i], p.radius_m[j]);
         let reach = ri + rj;
@@ -120,14 +130,19 @@ impl Context<'_> {
         let n = d / dist;
         let overlap = reach - dist;
         worst.note(overlap, ri.min(rj), i, j as u32);
-        let (wi, wj) = (p.angular_velocity_rad_per_s[i], p.angular_velocity_rad_per_s[j]);
+        let (wi, wj) = (
+            p.angular_velocity_rad_per_s[i],
+            p.angular_velocity_rad_per_s[j],
+        );
         let (mi, mj) = (p.mass_kg[i], p.mass_kg[j]);
         let k = ContactKinematics {
             normal: n,
             overlap_m: overlap,
             effective_radius_m: ri * rj / reach,
             effective_mass_kg: mi * mj / (mi + mj),
-            contact_velocity: p.velocity_m_per_s[i] - p.velocity_m_per_s[j] - (wi * ri + wj * rj).cross(&n),
+            contact_velocity: p.velocity_m_per_s[i]
+                - p.velocity_m_per_s[j]
+                - (wi * ri + wj * rj).cross(&n),
             relative_angular_velocity: wi - wj,
         };
         let mat = self.table.get(p.species[i], p.species[j]);
@@ -246,7 +261,14 @@ fn serial(
         }
         let walls = list.walls_of(i);
         let (mut f, mut t) = (force[i], torque[i]);
-        ctx.walls(i, &list.wall_partner[walls.clone()], &mut history.wall[walls], &mut f, &mut t, &mut worst);
+        ctx.walls(
+            i,
+            &list.wall_partner[walls.clone()],
+            &mut history.wall[walls],
+            &mut f,
+            &mut t,
+            &mut worst,
+        );
         force[i] = f;
         torque[i] = t;
     }
@@ -279,10 +301,15 @@ fn parallel(
     buffers.force_on_i.resize(n_slots, Vec3::zeros());
     buffers.torque_on_i.resize(n_slots, Vec3::zeros());
     buffers.torque_on_j.resize(n_slots, Vec3::zeros());
-    let chunk_bounds: Vec<usize> = (1..=n.div_ceil(CHUNK)).map(|c| (c * CHUNK).min(n)).collect();
+    let chunk_bounds: Vec<usize> = (1..=n.div_ceil(CHUNK))
+        .map(|c| (c * CHUNK).min(n))
+        .collect();
 
     // Pass 1: every pair slot, in parallel by chunks of first particles.
-    let pair_ends: Vec<usize> = chunk_bounds.iter().map(|&hi| list.start[hi] as usize).collect();
+    let pair_ends: Vec<usize> = chunk_bounds
+        .iter()
+        .map(|&hi| list.start[hi] as usize)
+        .collect();
     let hist_parts = split_by_offsets(&mut history.pair, &pair_ends);
     let f_parts = split_by_offsets(&mut buffers.force_on_i, &pair_ends);
     let ti_parts = split_by_offsets(&mut buffers.torque_on_i, &pair_ends);
@@ -314,7 +341,10 @@ fn parallel(
 
     // Pass 2: gather per particle in the serial order, then walls.
     let pair_hist = &history.pair;
-    let wall_ends: Vec<usize> = chunk_bounds.iter().map(|&hi| list.wall_start[hi] as usize).collect();
+    let wall_ends: Vec<usize> = chunk_bounds
+        .iter()
+        .map(|&hi| list.wall_start[hi] as usize)
+        .collect();
     let wall_hist_parts = split_by_offsets(&mut history.wall, &wall_ends);
     let worst_walls = force
         .par_chunks_mut(CHUNK)
@@ -345,7 +375,14 @@ fn parallel(
                 }
                 let walls = list.walls_of(p);
                 let local = walls.start - wall_base..walls.end - wall_base;
-                ctx.walls(p, &list.wall_partner[walls], &mut wall_hist[local], &mut f, &mut t, &mut worst);
+                ctx.walls(
+                    p,
+                    &list.wall_partner[walls],
+                    &mut wall_hist[local],
+                    &mut f,
+                    &mut t,
+                    &mut worst,
+                );
                 *f_out = f;
                 *t_out = t;
             }

@@ -24,7 +24,11 @@ pub fn half_kick(p: &mut Particles, gravity: &Vec3, dt_s: f64, pseudo_2d: bool) 
         .zip(p.angular_velocity_rad_per_s.par_chunks_mut(CHUNK))
         .zip(p.force_n.par_chunks(CHUNK))
         .zip(p.torque_n_m.par_chunks(CHUNK))
-        .zip(p.mass_kg.par_chunks(CHUNK).zip(p.inertia_kg_m2.par_chunks(CHUNK)))
+        .zip(
+            p.mass_kg
+                .par_chunks(CHUNK)
+                .zip(p.inertia_kg_m2.par_chunks(CHUNK)),
+        )
         .enumerate()
         .map(|(c, ((((v, w), f), t), (m, inertia)))| {
             let mut bad = None;
@@ -36,7 +40,9 @@ pub fn half_kick(p: &mut Particles, gravity: &Vec3, dt_s: f64, pseudo_2d: bool) 
                     w[k].x = 0.0;
                     w[k].y = 0.0;
                 }
-                if bad.is_none() && !(v[k].iter().all(|x| x.is_finite()) && w[k].iter().all(|x| x.is_finite())) {
+                if bad.is_none()
+                    && !(v[k].iter().all(|x| x.is_finite()) && w[k].iter().all(|x| x.is_finite()))
+                {
                     bad = Some(c * CHUNK + k);
                 }
             }
@@ -47,7 +53,12 @@ pub fn half_kick(p: &mut Particles, gravity: &Vec3, dt_s: f64, pseudo_2d: bool) 
 }
 
 /// x += v dt, wrapped on periodic axes. Returns the first particle that is non-finite or outside the box.
-pub fn drift(p: &mut Particles, domain: &Domain, dt_s: f64, lost_tolerance_m: f64) -> Option<usize> {
+pub fn drift(
+    p: &mut Particles,
+    domain: &Domain,
+    dt_s: f64,
+    lost_tolerance_m: f64,
+) -> Option<usize> {
     p.position_m
         .par_chunks_mut(CHUNK)
         .zip(p.velocity_m_per_s.par_chunks(CHUNK))
@@ -57,7 +68,10 @@ pub fn drift(p: &mut Particles, domain: &Domain, dt_s: f64, lost_tolerance_m: f6
             for k in 0..x.len() {
                 x[k] += v[k] * dt_s;
                 domain.wrap(&mut x[k]);
-                if bad.is_none() && (!x[k].iter().all(|a| a.is_finite()) || domain.is_lost(&x[k], lost_tolerance_m)) {
+                if bad.is_none()
+                    && (!x[k].iter().all(|a| a.is_finite())
+                        || domain.is_lost(&x[k], lost_tolerance_m))
+                {
                     bad = Some(c * CHUNK + k);
                 }
             }

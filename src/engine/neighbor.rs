@@ -51,7 +51,13 @@ impl NeighborList {
 
     /// True when the list may miss a contact: some particle moved more than skin/2 since the build (two particles
     /// closing on each other use up the skin), or a moving wall's surface moved more than skin/2.
-    pub fn needs_rebuild(&self, domain: &Domain, position: &[Vec3], walls: &[Wall], wall_angle: &[f64]) -> bool {
+    pub fn needs_rebuild(
+        &self,
+        domain: &Domain,
+        position: &[Vec3],
+        walls: &[Wall],
+        wall_angle: &[f64],
+    ) -> bool {
         if self.reference_position.len() != position.len() || self.builds == 0 {
             return true;
         }
@@ -158,7 +164,9 @@ impl NeighborList {
                     let xi = position[i];
                     let ri = radius[i];
                     for &cell in &neighbor_cells {
-                        for &j in &cell_particle[cell_start[cell] as usize..cell_start[cell + 1] as usize] {
+                        for &j in
+                            &cell_particle[cell_start[cell] as usize..cell_start[cell + 1] as usize]
+                        {
                             let j = j as usize;
                             if j <= i {
                                 continue;
@@ -249,14 +257,22 @@ mod tests {
     /// The cell-list half list equals the brute-force one, on a periodic box with few cells per axis.
     #[test]
     fn matches_brute_force_with_periodic_axes() {
-        let domain = Domain { lo_m: Vec3::zeros(), hi_m: Vec3::new(1.0, 0.5, 0.3), periodic: [true, false, true] };
+        let domain = Domain {
+            lo_m: Vec3::zeros(),
+            hi_m: Vec3::new(1.0, 0.5, 0.3),
+            periodic: [true, false, true],
+        };
         let mut state = 12345u64;
         let mut rnd = || {
-            state = state.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+            state = state
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
             (state >> 11) as f64 / (1u64 << 53) as f64
         };
         let n = 400;
-        let position: Vec<Vec3> = (0..n).map(|_| Vec3::new(rnd(), 0.5 * rnd(), 0.3 * rnd())).collect();
+        let position: Vec<Vec3> = (0..n)
+            .map(|_| Vec3::new(rnd(), 0.5 * rnd(), 0.3 * rnd()))
+            .collect();
         let radius: Vec<f64> = (0..n).map(|_| 0.02 + 0.02 * rnd()).collect();
         let mut list = NeighborList::default();
         list.build(&domain, &position, &radius, 0.01, &[], &[]);
@@ -268,11 +284,16 @@ mod tests {
                     expected.push(j as u32);
                 }
             }
-            assert_eq!(&list.partner[list.pairs_of(i)], expected.as_slice(), "particle {i}");
+            assert_eq!(
+                &list.partner[list.pairs_of(i)],
+                expected.as_slice(),
+                "particle {i}"
+            );
         }
         // The transpose lists every slot once, grouped by partner, ascending in the first particle.
         for j in 0..n {
-            let slots = &list.reverse_slot[list.reverse_start[j] as usize..list.reverse_start[j + 1] as usize];
+            let slots = &list.reverse_slot
+                [list.reverse_start[j] as usize..list.reverse_start[j + 1] as usize];
             let mut last_i = None;
             for &s in slots {
                 assert_eq!(list.partner[s as usize] as usize, j);

@@ -91,7 +91,11 @@ impl Simulation {
     }
 
     /// Resumes from a checkpointed state; the next `step()` continues exactly where the saved run was.
-    pub fn restore(config: Arc<SimConfig>, state: SimState, threads: usize) -> Result<Self, NumericalError> {
+    pub fn restore(
+        config: Arc<SimConfig>,
+        state: SimState,
+        threads: usize,
+    ) -> Result<Self, NumericalError> {
         let mut sim = Simulation {
             config,
             particles: state.particles,
@@ -167,7 +171,10 @@ impl Simulation {
 
     /// Approximate heap bytes of state and workspace.
     pub fn heap_bytes(&self) -> usize {
-        self.particles.heap_bytes() + self.list.heap_bytes() + self.history.heap_bytes() + self.buffers.heap_bytes()
+        self.particles.heap_bytes()
+            + self.list.heap_bytes()
+            + self.history.heap_bytes()
+            + self.buffers.heap_bytes()
     }
 
     /// Advances `n` steps.
@@ -277,7 +284,14 @@ impl Simulation {
 
     fn refresh_neighbors(&mut self, force: bool) {
         let c = &self.config;
-        if !force && !self.list.needs_rebuild(&c.domain, &self.particles.position_m, &c.walls, &self.wall_angle_rad) {
+        if !force
+            && !self.list.needs_rebuild(
+                &c.domain,
+                &self.particles.position_m,
+                &c.walls,
+                &self.wall_angle_rad,
+            )
+        {
             return;
         }
         let store = self.history.to_store(&self.list);
@@ -306,8 +320,13 @@ impl Simulation {
         use super::models::NormalModel;
         let c = &self.config;
         let p = &self.particles;
-        let potential = |mat: &super::models::PairMaterial, r_star: f64, overlap: f64| match c.contact_law.normal {
-            NormalModel::LinearSpringDashpot { stiffness_n_per_m, .. } => 0.5 * stiffness_n_per_m * overlap * overlap,
+        let potential = |mat: &super::models::PairMaterial, r_star: f64, overlap: f64| match c
+            .contact_law
+            .normal
+        {
+            NormalModel::LinearSpringDashpot {
+                stiffness_n_per_m, ..
+            } => 0.5 * stiffness_n_per_m * overlap * overlap,
             NormalModel::Hertz { .. } | NormalModel::Thornton { .. } => {
                 8.0 / 15.0 * mat.effective_youngs_modulus_pa * r_star.sqrt() * overlap.powf(2.5)
             }
@@ -316,19 +335,33 @@ impl Simulation {
         for i in 0..p.len() {
             for k in self.list.pairs_of(i) {
                 let j = self.list.partner[k] as usize;
-                let d = c.domain.separation(&p.position_m[i], &p.position_m[j]).norm();
+                let d = c
+                    .domain
+                    .separation(&p.position_m[i], &p.position_m[j])
+                    .norm();
                 let overlap = p.radius_m[i] + p.radius_m[j] - d;
                 if overlap > 0.0 {
                     let r_star = p.radius_m[i] * p.radius_m[j] / (p.radius_m[i] + p.radius_m[j]);
-                    e += potential(c.pair_table.get(p.species[i], p.species[j]), r_star, overlap);
+                    e += potential(
+                        c.pair_table.get(p.species[i], p.species[j]),
+                        r_star,
+                        overlap,
+                    );
                 }
             }
             for k in self.list.walls_of(i) {
                 let w = self.list.wall_partner[k] as usize;
                 let wall = &c.walls[w];
-                let overlap = p.radius_m[i] - wall.proximity(&p.position_m[i], self.wall_angle_rad[w]).gap_m;
+                let overlap = p.radius_m[i]
+                    - wall
+                        .proximity(&p.position_m[i], self.wall_angle_rad[w])
+                        .gap_m;
                 if overlap > 0.0 {
-                    e += potential(c.pair_table.get(p.species[i], wall.species), p.radius_m[i], overlap);
+                    e += potential(
+                        c.pair_table.get(p.species[i], wall.species),
+                        p.radius_m[i],
+                        overlap,
+                    );
                 }
             }
         }
@@ -339,14 +372,20 @@ impl Simulation {
     pub fn mechanical_energy_j(&self) -> (f64, f64) {
         let g = self.config.gravity.at(self.time_s);
         let p = &self.particles;
-        let potential: f64 = (0..p.len()).map(|i| -p.mass_kg[i] * g.dot(&p.position_m[i])).sum();
+        let potential: f64 = (0..p.len())
+            .map(|i| -p.mass_kg[i] * g.dot(&p.position_m[i]))
+            .sum();
         (p.kinetic_energy_j(), potential)
     }
 
     /// Height of the bed along −g: the highest particle top, and the mean centre height, in m.
     pub fn bed_height_m(&self) -> (f64, f64) {
         let g = self.config.gravity.at(self.time_s);
-        let up = if g.norm() > 0.0 { -g.normalize() } else { Vec3::z() };
+        let up = if g.norm() > 0.0 {
+            -g.normalize()
+        } else {
+            Vec3::z()
+        };
         let p = &self.particles;
         let mut top = f64::NEG_INFINITY;
         let mut sum = 0.0;

@@ -5,7 +5,9 @@
 use rand_chacha::ChaCha8Rng;
 use rand_chacha::rand_core::SeedableRng;
 
+use super::Vec3;
 use super::contacts::ContactStore;
+use super::models::ContactHistory;
 use super::particles::Particles;
 
 /// The complete state of a ChaCha8 generator: seed, stream and position.
@@ -49,4 +51,173 @@ pub struct SimState {
     pub wall_angle_rad: Vec<f64>,
     pub contacts: ContactStore,
     pub rng: RngState,
+}
+
+/// Bit-level comparison of two states: `None` when every value is identical to the bit (`to_bits()` for floats),
+/// otherwise the first differing field, e.g. `particles.velocity_m_per_s[17].y: 0x3f... vs 0x3f...`. The restart
+/// and thread-count tests use it, so a failure names the structure that differs.
+pub fn first_difference(a: &SimState, b: &SimState) -> Option<String> {
+    fn f(name: &str, x: f64, y: f64) -> Option<String> {
+        (x.to_bits() != y.to_bits()).then(|| {
+            format!(
+                "{name}: {x:e} (0x{:016x}) vs {y:e} (0x{:016x})",
+                x.to_bits(),
+                y.to_bits()
+            )
+        })
+    }
+    fn v(name: &str, x: &Vec3, y: &Vec3) -> Option<String> {
+        ["x", "y", "z"]
+            .iter()
+            .enumerate()
+            .find_map(|(k, c)| f(&format!("{name}.{c}"), x[k], y[k]))
+    }
+    fn scalars(name: &str, x: &[f64], y: &[f64]) -> Option<String> {
+        if x.len() != y.len() {
+            return Some(format!("{name}: length {} vs {}", x.len(), y.len()));
+        }
+        x.iter()
+            .zip(y)
+            .enumerate()
+            .find_map(|(i, (p, q))| f(&format!("{name}[{i}]"), *p, *q))
+    }
+    fn vectors(name: &str, x: &[Vec3], y: &[Vec3]) -> Option<String> {
+        if x.len() != y.len() {
+            return Some(format!("{name}: length {} vs {}", x.len(), y.len()));
+        }
+        x.iter()
+            .zip(y)
+            .enumerate()
+            .find_map(|(i, (p, q))| v(&format!("{name}[{i}]"), p, q))
+    }
+    fn history(name: &str, x: &ContactHistory, y: &ContactHistory) -> Option<String> {
+        if x.active != y.active || x.yielded != y.yielded {
+            return Some(format!(
+                "{name}: flags (active {}, yielded {}) vs ({}, {})",
+                x.active, x.yielded, y.active, y.yielded
+            ));
+        }
+        v(&format!("{name}.tangential"), &x.tangential, &y.tangential)
+            .or_else(|| {
+                v(
+                    &format!("{name}.reversal_force_n"),
+                    &x.reversal_force_n,
+                    &y.reversal_force_n,
+                )
+            })
+            .or_else(|| {
+                v(
+                    &format!("{name}.increment_direction"),
+                    &x.increment_direction,
+                    &y.increment_direction,
+                )
+            })
+            .or_else(|| {
+                f(
+                    &format!("{name}.max_overlap_m"),
+                    x.max_overlap_m,
+                    y.max_overlap_m,
+                )
+            })
+            .or_else(|| {
+                f(
+                    &format!("{name}.max_normal_force_n"),
+                    x.max_normal_force_n,
+                    y.max_normal_force_n,
+                )
+            })
+    }
+    if a.step != b.step {
+        return Some(format!("step: {} vs {}", a.step, b.step));
+    }
+    let (p, q) = (&a.particles, &b.particles);
+    if p.id != q.id || p.species != q.species {
+        return Some("particles.id or particles.species".into());
+    }
+    if a.rng != b.rng {
+        return Some("rng".into());
+    }
+    if a.contacts.pairs.len() != b.contacts.pairs.len() {
+        return Some(format!(
+            "contacts.pairs: {} vs {} active contacts",
+            a.contacts.pairs.len(),
+            b.contacts.pairs.len()
+        ));
+    }
+    if a.contacts.walls.len() != b.contacts.walls.len() {
+        return Some(format!(
+            "contacts.walls: {} vs {} active contacts",
+            a.contacts.walls.len(),
+            b.contacts.walls.len()
+        ));
+    }
+    f("time_s", a.time_s, b.time_s)
+        .or_else(|| f("dt_s", a.dt_s, b.dt_s))
+        .or_else(|| scalars("particles.radius_m", &p.radius_m, &q.radius_m))
+        .or_else(|| scalars("particles.mass_kg", &p.mass_kg, &q.mass_kg))
+        .or_else(|| {
+            scalars(
+                "particles.inertia_kg_m2",
+                &p.inertia_kg_m2,
+                &q.inertia_kg_m2,
+            )
+        })
+        .or_else(|| vectors("particles.position_m", &p.position_m, &q.position_m))
+        .or_else(|| {
+            vectors(
+                "particles.velocity_m_per_s",
+                &p.velocity_m_per_s,
+                &q.velocity_m_per_s,
+            )
+        })
+        .or_else(|| {
+            vectors(
+                "particles.angular_velocity_rad_per_s",
+                &p.angular_velocity_rad_per_s,
+                &q.angular_velocity_rad_per_s,
+            )
+        })
+        .or_else(|| vectors("particles.force_n", &p.force_n, &q.force_n))
+        .or_else(|| vectors("particles.torque_n_m", &p.torque_n_m, &q.torque_n_m))
+        .or_else(|| scalars("wall_angle_rad", &a.wall_angle_rad, &b.wall_angle_rad))
+        .or_else(|| {
+            a.contacts
+                .pairs
+                .iter()
+                .zip(&b.contacts.pairs)
+                .enumerate()
+                .find_map(|(k, (x, y))| {
+                    if (x.0, x.1) != (y.0, y.1) {
+                        return Some(format!(
+                            "contacts.pairs[{k}]: key ({}, {}) vs ({}, {})",
+                            x.0.0, x.1.0, y.0.0, y.1.0
+                        ));
+                    }
+                    history(
+                        &format!("contacts.pairs[{k}] ({}, {})", x.0.0, x.1.0),
+                        &x.2,
+                        &y.2,
+                    )
+                })
+        })
+        .or_else(|| {
+            a.contacts
+                .walls
+                .iter()
+                .zip(&b.contacts.walls)
+                .enumerate()
+                .find_map(|(k, (x, y))| {
+                    if (x.0, x.1) != (y.0, y.1) {
+                        return Some(format!(
+                            "contacts.walls[{k}]: key ({}, {}) vs ({}, {})",
+                            x.0.0, x.1.0, y.0.0, y.1.0
+                        ));
+                    }
+                    history(
+                        &format!("contacts.walls[{k}] ({}, wall {})", x.0.0, x.1.0),
+                        &x.2,
+                        &y.2,
+                    )
+                })
+        })
 }

@@ -75,10 +75,18 @@ impl Checker<'_> {
         Ok(u.normalize())
     }
 
-    fn species(&self, key: &str, table: &SpeciesTable, name: &str) -> Result<SpeciesId, ConfigError> {
+    fn species(
+        &self,
+        key: &str,
+        table: &SpeciesTable,
+        name: &str,
+    ) -> Result<SpeciesId, ConfigError> {
         table.find(name).ok_or_else(|| {
             let known: Vec<&str> = table.species.iter().map(|s| s.name.as_str()).collect();
-            self.fail(key, format!("unknown species '{name}'; defined: {}", known.join(", ")))
+            self.fail(
+                key,
+                format!("unknown species '{name}'; defined: {}", known.join(", ")),
+            )
         })
     }
 }
@@ -96,15 +104,24 @@ pub fn build(spec: ScenarioSpec, path: &Path) -> Result<BuiltScenario, ConfigErr
         c.positive(&key("density_kg_per_m3"), s.density_kg_per_m3)?;
         c.positive(&key("youngs_modulus_pa"), s.youngs_modulus_pa)?;
         if !(s.poisson_ratio.is_finite() && (0.0..0.5).contains(&s.poisson_ratio)) {
-            return Err(c.fail(key("poisson_ratio"), format!("expected 0 <= ν < 0.5, got {}", s.poisson_ratio)));
+            return Err(c.fail(
+                key("poisson_ratio"),
+                format!("expected 0 <= ν < 0.5, got {}", s.poisson_ratio),
+            ));
         }
         c.non_negative(&key("friction_coefficient"), s.friction_coefficient)?;
-        c.non_negative(&key("rolling_friction_coefficient"), s.rolling_friction_coefficient)?;
+        c.non_negative(
+            &key("rolling_friction_coefficient"),
+            s.rolling_friction_coefficient,
+        )?;
         if let Some(fy) = s.yield_force_n {
             c.positive(&key("yield_force_n"), fy)?;
         }
         if spec.species[..k].iter().any(|o| o.name == s.name) {
-            return Err(c.fail(key("name"), format!("species name '{}' is used twice", s.name)));
+            return Err(c.fail(
+                key("name"),
+                format!("species name '{}' is used twice", s.name),
+            ));
         }
     }
     let species = SpeciesTable {
@@ -119,7 +136,10 @@ pub fn build(spec: ScenarioSpec, path: &Path) -> Result<BuiltScenario, ConfigErr
         if spec.domain.hi_m[axis] <= spec.domain.lo_m[axis] {
             return Err(c.fail(
                 format!("domain.hi_m[{axis}]"),
-                format!("expected hi > lo, got lo {} and hi {}", spec.domain.lo_m[axis], spec.domain.hi_m[axis]),
+                format!(
+                    "expected hi > lo, got lo {} and hi {}",
+                    spec.domain.lo_m[axis], spec.domain.hi_m[axis]
+                ),
             ));
         }
     }
@@ -137,12 +157,24 @@ pub fn build(spec: ScenarioSpec, path: &Path) -> Result<BuiltScenario, ConfigErr
     let mut rng = RngState::from_seed_u64(spec.seed).restore();
     let particles = fill(&c, &spec, &species, &domain, &walls, &mut rng)?;
 
-    let skin_m = spec.neighbor.skin_m.unwrap_or(0.4 * particles.max_radius_m());
+    let skin_m = spec
+        .neighbor
+        .skin_m
+        .unwrap_or(0.4 * particles.max_radius_m());
     c.positive("neighbor.skin_m", skin_m)?;
     c.positive("time.end_time_s", spec.time.end_time_s)?;
-    c.positive("time.reference_velocity_m_per_s", spec.time.reference_velocity_m_per_s)?;
-    if !(spec.max_overlap_fraction.is_finite() && spec.max_overlap_fraction > 0.0 && spec.max_overlap_fraction <= 1.0) {
-        return Err(c.fail("max_overlap_fraction", format!("expected 0 < value <= 1, got {}", spec.max_overlap_fraction)));
+    c.positive(
+        "time.reference_velocity_m_per_s",
+        spec.time.reference_velocity_m_per_s,
+    )?;
+    if !(spec.max_overlap_fraction.is_finite()
+        && spec.max_overlap_fraction > 0.0
+        && spec.max_overlap_fraction <= 1.0)
+    {
+        return Err(c.fail(
+            "max_overlap_fraction",
+            format!("expected 0 < value <= 1, got {}", spec.max_overlap_fraction),
+        ));
     }
     if spec.output.checkpoint_every_steps == 0 {
         return Err(c.fail("output.checkpoint_every_steps", "expected at least 1"));
@@ -183,11 +215,19 @@ pub fn build(spec: ScenarioSpec, path: &Path) -> Result<BuiltScenario, ConfigErr
         }
         (None, Some(fraction)) => {
             if !(fraction.is_finite() && fraction > 0.0 && fraction <= 0.5) {
-                return Err(c.fail("time.dt_fraction_of_contact_time", format!("expected 0 < value <= 0.5, got {fraction}")));
+                return Err(c.fail(
+                    "time.dt_fraction_of_contact_time",
+                    format!("expected 0 < value <= 0.5, got {fraction}"),
+                ));
             }
             fraction * contact_time_s
         }
-        _ => return Err(c.fail("time", "give exactly one of dt_s and dt_fraction_of_contact_time")),
+        _ => {
+            return Err(c.fail(
+                "time",
+                "give exactly one of dt_s and dt_fraction_of_contact_time",
+            ));
+        }
     };
 
     let config = SimConfig {
@@ -217,12 +257,21 @@ fn check_contact_law(c: &Checker, law: &ContactLaw) -> Result<(), ConfigError> {
             stiffness_n_per_m,
             damping_kg_per_s,
         } => {
-            c.positive("contact.normal.linear_spring_dashpot.stiffness_n_per_m", stiffness_n_per_m)?;
-            c.non_negative("contact.normal.linear_spring_dashpot.damping_kg_per_s", damping_kg_per_s)?;
+            c.positive(
+                "contact.normal.linear_spring_dashpot.stiffness_n_per_m",
+                stiffness_n_per_m,
+            )?;
+            c.non_negative(
+                "contact.normal.linear_spring_dashpot.damping_kg_per_s",
+                damping_kg_per_s,
+            )?;
         }
         NormalModel::Hertz { restitution } => {
             if !(restitution.is_finite() && restitution > 0.0 && restitution <= 1.0) {
-                return Err(c.fail("contact.normal.hertz.restitution", format!("expected 0 < e <= 1, got {restitution}")));
+                return Err(c.fail(
+                    "contact.normal.hertz.restitution",
+                    format!("expected 0 < e <= 1, got {restitution}"),
+                ));
             }
         }
         NormalModel::Thornton { .. } => {}
@@ -233,8 +282,14 @@ fn check_contact_law(c: &Checker, law: &ContactLaw) -> Result<(), ConfigError> {
             stiffness_n_per_m,
             damping_kg_per_s,
         } => {
-            c.non_negative("contact.tangential.linear_spring_coulomb.stiffness_n_per_m", stiffness_n_per_m)?;
-            c.non_negative("contact.tangential.linear_spring_coulomb.damping_kg_per_s", damping_kg_per_s)?;
+            c.non_negative(
+                "contact.tangential.linear_spring_coulomb.stiffness_n_per_m",
+                stiffness_n_per_m,
+            )?;
+            c.non_negative(
+                "contact.tangential.linear_spring_coulomb.damping_kg_per_s",
+                damping_kg_per_s,
+            )?;
         }
         TangentialModel::Mindlin | TangentialModel::WaltonBraun { .. } if !hertzian => {
             return Err(c.fail(
@@ -245,13 +300,20 @@ fn check_contact_law(c: &Checker, law: &ContactLaw) -> Result<(), ConfigError> {
                 ),
             ));
         }
-        TangentialModel::WaltonBraun { exponent } => c.positive("contact.tangential.walton_braun.exponent", exponent)?,
+        TangentialModel::WaltonBraun { exponent } => {
+            c.positive("contact.tangential.walton_braun.exponent", exponent)?
+        }
         TangentialModel::Mindlin => {}
     }
     Ok(())
 }
 
-fn build_walls(c: &Checker, spec: &ScenarioSpec, species: &SpeciesTable, domain: &Domain) -> Result<Vec<Wall>, ConfigError> {
+fn build_walls(
+    c: &Checker,
+    spec: &ScenarioSpec,
+    species: &SpeciesTable,
+    domain: &Domain,
+) -> Result<Vec<Wall>, ConfigError> {
     let mut walls = Vec::new();
     for (k, w) in spec.walls.iter().enumerate() {
         match w {
@@ -262,13 +324,17 @@ fn build_walls(c: &Checker, spec: &ScenarioSpec, species: &SpeciesTable, domain:
                         continue;
                     }
                     let axis_name = ["x", "y", "z"][axis];
-                    for (side, point, sign) in [("lo", domain.lo_m, 1.0), ("hi", domain.hi_m, -1.0)] {
+                    for (side, point, sign) in [("lo", domain.lo_m, 1.0), ("hi", domain.hi_m, -1.0)]
+                    {
                         let mut normal = Vec3::zeros();
                         normal[axis] = sign;
                         walls.push(Wall {
                             name: format!("box_{axis_name}_{side}"),
                             species: id,
-                            shape: WallShape::Plane { point_m: point, normal },
+                            shape: WallShape::Plane {
+                                point_m: point,
+                                normal,
+                            },
                         });
                     }
                 }
@@ -298,7 +364,10 @@ fn build_walls(c: &Checker, spec: &ScenarioSpec, species: &SpeciesTable, domain:
                 let axis = c.unit3(&key("axis"), &d.axis)?;
                 c.positive(&key("radius_m"), d.radius_m)?;
                 if !d.rotation_rpm.is_finite() {
-                    return Err(c.fail(key("rotation_rpm"), format!("expected a finite number, got {}", d.rotation_rpm)));
+                    return Err(c.fail(
+                        key("rotation_rpm"),
+                        format!("expected a finite number, got {}", d.rotation_rpm),
+                    ));
                 }
                 let omega = d.rotation_rpm * 2.0 * PI / 60.0;
                 let frame = RotatingFrame::new(Vec3::from(d.axis_point_m), axis, omega);
@@ -329,7 +398,10 @@ fn build_walls(c: &Checker, spec: &ScenarioSpec, species: &SpeciesTable, domain:
         }
     }
     if walls.len() > u16::MAX as usize {
-        return Err(c.fail("walls", format!("at most {} walls, got {}", u16::MAX, walls.len())));
+        return Err(c.fail(
+            "walls",
+            format!("at most {} walls, got {}", u16::MAX, walls.len()),
+        ));
     }
     Ok(walls)
 }
@@ -357,10 +429,16 @@ fn baffle_segments(
                 return Err(c.fail(key("count"), "expected at least 1"));
             }
             if length_m >= drum_radius_m {
-                return Err(c.fail(key("length_m"), format!("a wall baffle must be shorter than the drum radius {drum_radius_m} m")));
+                return Err(c.fail(
+                    key("length_m"),
+                    format!("a wall baffle must be shorter than the drum radius {drum_radius_m} m"),
+                ));
             }
             if !(tilt_deg.is_finite() && tilt_deg.abs() < 80.0) {
-                return Err(c.fail(key("tilt_deg"), format!("expected |tilt| < 80°, got {tilt_deg}")));
+                return Err(c.fail(
+                    key("tilt_deg"),
+                    format!("expected |tilt| < 80°, got {tilt_deg}"),
+                ));
             }
             let tilt = tilt_deg.to_radians();
             for k in 0..count as usize {
@@ -368,7 +446,10 @@ fn baffle_segments(
                 let base = [drum_radius_m * phi.cos(), drum_radius_m * phi.sin()];
                 // Inward radial direction turned by the tilt.
                 let dir_angle = phi + PI + tilt;
-                let tip = [base[0] + length_m * dir_angle.cos(), base[1] + length_m * dir_angle.sin()];
+                let tip = [
+                    base[0] + length_m * dir_angle.cos(),
+                    base[1] + length_m * dir_angle.sin(),
+                ];
                 out.push((k, (base, tip), half_thickness_m));
             }
         }
@@ -394,13 +475,19 @@ fn baffle_segments(
                 out.push((0, ([-h, 0.0], [h, 0.0]), half_thickness_m));
             } else {
                 if inner_radius_m + length_m >= drum_radius_m {
-                    return Err(c.fail(key("length_m"), "inner_radius_m + length_m must be less than the drum radius"));
+                    return Err(c.fail(
+                        key("length_m"),
+                        "inner_radius_m + length_m must be less than the drum radius",
+                    ));
                 }
                 for k in 0..count as usize {
                     let phi = 2.0 * PI * k as f64 / count as f64;
                     let (s, co) = phi.sin_cos();
                     let a = [inner_radius_m * co, inner_radius_m * s];
-                    let b = [(inner_radius_m + length_m) * co, (inner_radius_m + length_m) * s];
+                    let b = [
+                        (inner_radius_m + length_m) * co,
+                        (inner_radius_m + length_m) * s,
+                    ];
                     out.push((k, (a, b), half_thickness_m));
                 }
             }
@@ -426,7 +513,12 @@ fn fits(x: &Vec3, r: f64, walls: &[Wall], domain: &Domain) -> bool {
         && walls.iter().all(|w| w.proximity(x, 0.0).gap_m >= r)
 }
 
-fn drum_named<'a>(c: &Checker, key: &str, walls: &'a [Wall], name: &str) -> Result<&'a Wall, ConfigError> {
+fn drum_named<'a>(
+    c: &Checker,
+    key: &str,
+    walls: &'a [Wall],
+    name: &str,
+) -> Result<&'a Wall, ConfigError> {
     walls
         .iter()
         .find(|w| w.name == name && matches!(w.shape, WallShape::RotatingCylinder { .. }))
@@ -479,7 +571,10 @@ fn fill(
                 }
                 let count: i64 = range.iter().map(|(a, b)| (b - a + 1).max(0)).product();
                 if count > 50_000_000 {
-                    return Err(c.fail(key("spacing_m"), format!("the lattice would hold {count} points (limit 5e7)")));
+                    return Err(c.fail(
+                        key("spacing_m"),
+                        format!("the lattice would hold {count} points (limit 5e7)"),
+                    ));
                 }
                 let before = particles.len();
                 for iz in range[2].0..=range[2].1 {
@@ -500,7 +595,10 @@ fn fill(
                     }
                 }
                 if particles.len() == before {
-                    return Err(c.fail(format!("fill[{k}].lattice"), "no particle fits: the lattice region lies outside the walls or the box"));
+                    return Err(c.fail(
+                        format!("fill[{k}].lattice"),
+                        "no particle fits: the lattice region lies outside the walls or the box",
+                    ));
                 }
             }
             FillSpec::Explicit {
@@ -515,11 +613,18 @@ fn fill(
                 if positions_m.is_empty() {
                     return Err(c.fail(key("positions_m"), "expected at least one position"));
                 }
-                for (name, list) in [("velocities_m_per_s", velocities_m_per_s), ("angular_velocities_rad_per_s", angular_velocities_rad_per_s)] {
+                for (name, list) in [
+                    ("velocities_m_per_s", velocities_m_per_s),
+                    ("angular_velocities_rad_per_s", angular_velocities_rad_per_s),
+                ] {
                     if !list.is_empty() && list.len() != positions_m.len() {
                         return Err(c.fail(
                             key(name),
-                            format!("expected {} entries (one per position) or none, got {}", positions_m.len(), list.len()),
+                            format!(
+                                "expected {} entries (one per position) or none, got {}",
+                                positions_m.len(),
+                                list.len()
+                            ),
                         ));
                     }
                 }
@@ -529,7 +634,10 @@ fn fill(
                     // CHOICE: explicit particles may start pressed into a wall by up to 1 % of their radius (a
                     // particle resting at its static overlap); anything more is an input error.
                     if !fits(&x, 0.99 * sp.radius_m, walls, domain) {
-                        return Err(c.fail(key(&format!("positions_m[{n}]")), "the particle overlaps a wall or leaves the box"));
+                        return Err(c.fail(
+                            key(&format!("positions_m[{n}]")),
+                            "the particle overlaps a wall or leaves the box",
+                        ));
                     }
                     let id = particles.push(id, sp, sp.radius_m, x);
                     if let Some(v) = velocities_m_per_s.get(n) {
@@ -571,7 +679,17 @@ fn fill(
                         ),
                     ));
                 }
-                let placed = random_insert(&mut particles, id, sp, *count as usize, lo_m, hi_m, walls, domain, rng);
+                let placed = random_insert(
+                    &mut particles,
+                    id,
+                    sp,
+                    *count as usize,
+                    lo_m,
+                    hi_m,
+                    walls,
+                    domain,
+                    rng,
+                );
                 if placed < *count as usize {
                     return Err(c.fail(
                         key("count"),
@@ -604,7 +722,9 @@ fn random_insert(
     // Lookup only (never iterated), so the map's order cannot leak into results; BTreeMap keeps it obviously so.
     let mut grid: BTreeMap<[i64; 3], Vec<usize>> = BTreeMap::new();
     for i in 0..particles.len() {
-        grid.entry(key(&particles.position_m[i])).or_default().push(i);
+        grid.entry(key(&particles.position_m[i]))
+            .or_default()
+            .push(i);
     }
     let mut placed = 0;
     let max_attempts = 1000 * count;
@@ -625,24 +745,31 @@ fn random_insert(
             // The grid does not wrap; periodic images are checked by brute force (fills are built once).
             clear = (0..particles.len()).all(|j| {
                 let reach = r + particles.radius_m[j];
-                domain.separation(&x, &particles.position_m[j]).norm_squared() >= reach * reach
+                domain
+                    .separation(&x, &particles.position_m[j])
+                    .norm_squared()
+                    >= reach * reach
             });
         } else {
-        'search: for dz in -1..=1 {
-            for dy in -1..=1 {
-                for dx in -1..=1 {
-                    if let Some(list) = grid.get(&[k[0] + dx, k[1] + dy, k[2] + dz]) {
-                        for &j in list {
-                            let reach = r + particles.radius_m[j];
-                            if domain.separation(&x, &particles.position_m[j]).norm_squared() < reach * reach {
-                                clear = false;
-                                break 'search;
+            'search: for dz in -1..=1 {
+                for dy in -1..=1 {
+                    for dx in -1..=1 {
+                        if let Some(list) = grid.get(&[k[0] + dx, k[1] + dy, k[2] + dz]) {
+                            for &j in list {
+                                let reach = r + particles.radius_m[j];
+                                if domain
+                                    .separation(&x, &particles.position_m[j])
+                                    .norm_squared()
+                                    < reach * reach
+                                {
+                                    clear = false;
+                                    break 'search;
+                                }
                             }
                         }
                     }
                 }
             }
-        }
         }
         if clear {
             let i = particles.len();

@@ -55,7 +55,9 @@ impl Domain {
     #[inline]
     pub fn is_lost(&self, x: &Vec3, tolerance_m: f64) -> bool {
         (0..3).any(|axis| {
-            !self.periodic[axis] && (x[axis] < self.lo_m[axis] - tolerance_m || x[axis] > self.hi_m[axis] + tolerance_m)
+            !self.periodic[axis]
+                && (x[axis] < self.lo_m[axis] - tolerance_m
+                    || x[axis] > self.hi_m[axis] + tolerance_m)
         })
     }
 }
@@ -117,14 +119,24 @@ mod tests {
 
     #[test]
     fn minimum_image_on_periodic_axis_only() {
-        let d = Domain { lo_m: Vec3::zeros(), hi_m: Vec3::new(1.0, 1.0, 1.0), periodic: [true, false, false] };
+        let d = Domain {
+            lo_m: Vec3::zeros(),
+            hi_m: Vec3::new(1.0, 1.0, 1.0),
+            periodic: [true, false, false],
+        };
         let s = d.separation(&Vec3::new(0.95, 0.9, 0.0), &Vec3::new(0.05, 0.1, 0.0));
         assert!((s.x + 0.1).abs() < 1e-12 && (s.y - 0.8).abs() < 1e-12);
     }
 
     #[test]
     fn gravity_flips_every_half_period() {
-        let g = Gravity { vector_m_per_s2: [1.0, -2.0, 0.0], flip: Some(GravityFlip { axis: Axis::Y, frequency_hz: 2.0 }) };
+        let g = Gravity {
+            vector_m_per_s2: [1.0, -2.0, 0.0],
+            flip: Some(GravityFlip {
+                axis: Axis::Y,
+                frequency_hz: 2.0,
+            }),
+        };
         assert_eq!(g.at(0.1).y, -2.0);
         assert_eq!(g.at(0.3).y, 2.0);
         assert_eq!(g.at(0.6).y, -2.0);

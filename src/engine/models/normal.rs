@@ -86,7 +86,10 @@ impl NormalModel {
                 let e_star = mat.effective_youngs_modulus_pa;
                 let kn = 4.0 / 3.0 * e_star * contact_radius;
                 let sn = 2.0 * e_star * contact_radius;
-                let gamma_n = 2.0 * SQRT_FIVE_SIXTHS * damping_beta(restitution) * (sn * effective_mass_kg).sqrt();
+                let gamma_n = 2.0
+                    * SQRT_FIVE_SIXTHS
+                    * damping_beta(restitution)
+                    * (sn * effective_mass_kg).sqrt();
                 NormalOutput {
                     force_n: kn * overlap_m - gamma_n * normal_velocity_m_per_s,
                     contact_radius_m: contact_radius,
@@ -127,7 +130,9 @@ impl NormalModel {
             }
             NormalModel::Hertz { .. } | NormalModel::Thornton { .. } => {
                 let e = mat.effective_youngs_modulus_pa;
-                2.87 * (effective_mass_kg.powi(2) / (effective_radius_m * e * e * impact_velocity_m_per_s)).powf(0.2)
+                2.87 * (effective_mass_kg.powi(2)
+                    / (effective_radius_m * e * e * impact_velocity_m_per_s))
+                    .powf(0.2)
             }
         }
     }
@@ -181,7 +186,8 @@ pub fn thornton_force(
         kn * overlap_m * overlap_m.sqrt()
     } else {
         let f_max = hist.max_normal_force_n;
-        let r_bar = (yield_force_n / f_max) * ((2.0 * f_max + yield_force_n) / (3.0 * yield_force_n)).powf(1.5);
+        let r_bar = (yield_force_n / f_max)
+            * ((2.0 * f_max + yield_force_n) / (3.0 * yield_force_n)).powf(1.5);
         let k_unload = kn * r_bar.sqrt();
         let plastic_overlap = hist.max_overlap_m - (f_max / k_unload).powf(2.0 / 3.0);
         let elastic = overlap_m - plastic_overlap;
@@ -238,10 +244,24 @@ mod tests {
         let kn = 4.0 / 3.0 * mat.effective_youngs_modulus_pa * r.sqrt();
         let ay = (mat.yield_force_n / kn).powf(2.0 / 3.0);
         let mut h = ContactHistory::default();
-        let below = thornton_force(mat.effective_youngs_modulus_pa, r, mat.yield_force_n, PlasticSlope::Continuous, 0.5 * ay, &mut h);
+        let below = thornton_force(
+            mat.effective_youngs_modulus_pa,
+            r,
+            mat.yield_force_n,
+            PlasticSlope::Continuous,
+            0.5 * ay,
+            &mut h,
+        );
         assert!((below - kn * (0.5 * ay).powf(1.5)).abs() < 1e-12 * below);
         assert!(!h.yielded);
-        let just_above = thornton_force(mat.effective_youngs_modulus_pa, r, mat.yield_force_n, PlasticSlope::Continuous, ay * (1.0 + 1e-9), &mut h);
+        let just_above = thornton_force(
+            mat.effective_youngs_modulus_pa,
+            r,
+            mat.yield_force_n,
+            PlasticSlope::Continuous,
+            ay * (1.0 + 1e-9),
+            &mut h,
+        );
         assert!((just_above - mat.yield_force_n).abs() < 1e-6 * mat.yield_force_n);
         assert!(h.yielded);
     }
@@ -254,11 +274,32 @@ mod tests {
         let kn = 4.0 / 3.0 * mat.effective_youngs_modulus_pa * r.sqrt();
         let ay = (mat.yield_force_n / kn).powf(2.0 / 3.0);
         let amax = 3.0 * ay;
-        let fmax = thornton_force(mat.effective_youngs_modulus_pa, r, mat.yield_force_n, PlasticSlope::Continuous, amax, &mut h);
-        let f_back = thornton_force(mat.effective_youngs_modulus_pa, r, mat.yield_force_n, PlasticSlope::Continuous, amax * (1.0 - 1e-12), &mut h);
+        let fmax = thornton_force(
+            mat.effective_youngs_modulus_pa,
+            r,
+            mat.yield_force_n,
+            PlasticSlope::Continuous,
+            amax,
+            &mut h,
+        );
+        let f_back = thornton_force(
+            mat.effective_youngs_modulus_pa,
+            r,
+            mat.yield_force_n,
+            PlasticSlope::Continuous,
+            amax * (1.0 - 1e-12),
+            &mut h,
+        );
         assert!((f_back - fmax).abs() < 1e-6 * fmax, "{f_back} vs {fmax}");
         // Residual plastic overlap: zero force at a positive overlap.
-        let f_small = thornton_force(mat.effective_youngs_modulus_pa, r, mat.yield_force_n, PlasticSlope::Continuous, 0.3 * ay, &mut h);
+        let f_small = thornton_force(
+            mat.effective_youngs_modulus_pa,
+            r,
+            mat.yield_force_n,
+            PlasticSlope::Continuous,
+            0.3 * ay,
+            &mut h,
+        );
         assert_eq!(f_small, 0.0);
     }
 

@@ -70,7 +70,15 @@ impl TangentialModel {
             TangentialModel::LinearSpringCoulomb {
                 stiffness_n_per_m,
                 damping_kg_per_s,
-            } => spring_with_coulomb_limit(stiffness_n_per_m, damping_kg_per_s, limit, n, tangential_velocity, dt_s, hist),
+            } => spring_with_coulomb_limit(
+                stiffness_n_per_m,
+                damping_kg_per_s,
+                limit,
+                n,
+                tangential_velocity,
+                dt_s,
+                hist,
+            ),
             TangentialModel::Mindlin => {
                 let kt = 8.0 * mat.effective_shear_modulus_pa * normal.contact_radius_m;
                 let beta = match *normal_model {
@@ -150,7 +158,11 @@ fn walton_braun(
         let t = force.dot(&direction);
         let t_star = reversal.dot(&direction);
         let span = limit - t_star;
-        let fraction = if span > 0.0 { ((t - t_star) / span).clamp(0.0, 1.0) } else { 1.0 };
+        let fraction = if span > 0.0 {
+            ((t - t_star) / span).clamp(0.0, 1.0)
+        } else {
+            1.0
+        };
         let stiffness = initial_stiffness * (1.0 - fraction).powf(exponent);
         force += direction * (stiffness * slip_mag);
     }
@@ -182,32 +194,80 @@ mod tests {
     #[test]
     fn walton_braun_saturates_and_recovers_stiffness_on_reversal() {
         let n = Vec3::new(0.0, 0.0, 1.0);
-        let normal = NormalOutput { force_n: 2.0, contact_radius_m: 1e-5 };
-        let model = TangentialModel::WaltonBraun { exponent: 1.0 / 3.0 };
+        let normal = NormalOutput {
+            force_n: 2.0,
+            contact_radius_m: 1e-5,
+        };
+        let model = TangentialModel::WaltonBraun {
+            exponent: 1.0 / 3.0,
+        };
         let mut h = ContactHistory::default();
         let v = Vec3::new(-0.1, 0.0, 0.0); // pushes F_t towards +x
         let mut f = Vec3::zeros();
         for _ in 0..20000 {
-            f = model.force(&NormalModel::Thornton { plastic_slope: Default::default() }, &mat(), 1e-6, &normal, &n, &v, 1e-5, &mut h);
+            f = model.force(
+                &NormalModel::Thornton {
+                    plastic_slope: Default::default(),
+                },
+                &mat(),
+                1e-6,
+                &normal,
+                &n,
+                &v,
+                1e-5,
+                &mut h,
+            );
         }
         assert!((f.x - 1.0).abs() < 1e-9, "saturates at μF_n = 1: {f:?}");
         let before = f.x;
         let kt0 = 8.0 * 4e7 * 1e-5;
-        let f2 = model.force(&NormalModel::Thornton { plastic_slope: Default::default() }, &mat(), 1e-6, &normal, &n, &(-v), 1e-5, &mut h);
+        let f2 = model.force(
+            &NormalModel::Thornton {
+                plastic_slope: Default::default(),
+            },
+            &mat(),
+            1e-6,
+            &normal,
+            &n,
+            &(-v),
+            1e-5,
+            &mut h,
+        );
         let slope = (before - f2.x) / (0.1 * 1e-5);
-        assert!((slope - kt0).abs() < 1e-6 * kt0, "fresh stiffness after reversal: {slope} vs {kt0}");
+        assert!(
+            (slope - kt0).abs() < 1e-6 * kt0,
+            "fresh stiffness after reversal: {slope} vs {kt0}"
+        );
     }
 
     #[test]
     fn linear_spring_truncates_at_coulomb_limit() {
         let n = Vec3::new(1.0, 0.0, 0.0);
-        let normal = NormalOutput { force_n: 1.0, contact_radius_m: 0.0 };
-        let model = TangentialModel::LinearSpringCoulomb { stiffness_n_per_m: 1000.0, damping_kg_per_s: 0.0 };
+        let normal = NormalOutput {
+            force_n: 1.0,
+            contact_radius_m: 0.0,
+        };
+        let model = TangentialModel::LinearSpringCoulomb {
+            stiffness_n_per_m: 1000.0,
+            damping_kg_per_s: 0.0,
+        };
         let mut h = ContactHistory::default();
         let v = Vec3::new(0.0, 1.0, 0.0);
         let mut f = Vec3::zeros();
         for _ in 0..1000 {
-            f = model.force(&NormalModel::LinearSpringDashpot { stiffness_n_per_m: 1.0, damping_kg_per_s: 0.0 }, &mat(), 1.0, &normal, &n, &v, 1e-4, &mut h);
+            f = model.force(
+                &NormalModel::LinearSpringDashpot {
+                    stiffness_n_per_m: 1.0,
+                    damping_kg_per_s: 0.0,
+                },
+                &mat(),
+                1.0,
+                &normal,
+                &n,
+                &v,
+                1e-4,
+                &mut h,
+            );
         }
         assert!((f.norm() - 0.5).abs() < 1e-12);
         assert!(f.y < 0.0);
