@@ -4,8 +4,8 @@
 use criterion::{Criterion, criterion_group, criterion_main};
 use granflow::engine::Vec3;
 use granflow::engine::models::{
-    ContactHistory, ContactKinematics, ContactLaw, NormalModel, PairMaterial, PlasticSlope,
-    RollingModel, TangentialModel,
+    ContactHistory, ContactKinematics, ContactLaw, NormalModel, PairMaterial, PlasticSlope, RollingModel,
+    TangentialModel,
 };
 use std::hint::black_box;
 
@@ -40,9 +40,7 @@ fn kernels(c: &mut Criterion) {
                 normal: NormalModel::Thornton {
                     plastic_slope: PlasticSlope::Continuous,
                 },
-                tangential: TangentialModel::WaltonBraun {
-                    exponent: 1.0 / 3.0,
-                },
+                tangential: TangentialModel::WaltonBraun { exponent: 1.0 / 3.0 },
                 rolling: RollingModel::None,
             },
         ),

@@ -79,13 +79,7 @@ pub fn run_granflow(threads: usize, steps: u64) -> Result<(RunFigures, Simulatio
         scenario::parse(BENCH_SCENARIO, Path::new("scenarios/bench-settle.yaml"))?,
         Path::new("scenarios/bench-settle.yaml"),
     )?;
-    let mut sim = Simulation::new(
-        built.config.clone(),
-        built.particles,
-        built.dt_s,
-        built.rng,
-        threads,
-    )?;
+    let mut sim = Simulation::new(built.config.clone(), built.particles, built.dt_s, built.rng, threads)?;
     let mut samples = vec![sample(&sim)];
     let start = Instant::now();
     while sim.step < steps {
@@ -133,8 +127,7 @@ pub fn run_liggghts(binary: &Path, input: &Path, steps: u64) -> Result<(RunFigur
     for line in text.lines() {
         if line.trim_start().starts_with("thermo_style") {
             saw_thermo_style = true;
-            modified
-                .push_str("compute gf_ztop all reduce max z\ncompute gf_zmean all reduce ave z\n");
+            modified.push_str("compute gf_ztop all reduce max z\ncompute gf_zmean all reduce ave z\n");
             modified.push_str("thermo_style custom step atoms ke c_gf_ztop c_gf_zmean\n");
         } else if line.trim_start().starts_with("run ") && steps != 20_000 {
             modified.push_str(&format!("run {steps}\n"));
@@ -149,8 +142,7 @@ pub fn run_liggghts(binary: &Path, input: &Path, steps: u64) -> Result<(RunFigur
             input.display()
         )));
     }
-    let dir = tempfile::tempdir()
-        .map_err(|e| Error::io("create temporary directory", std::env::temp_dir(), e))?;
+    let dir = tempfile::tempdir().map_err(|e| Error::io("create temporary directory", std::env::temp_dir(), e))?;
     let copy = dir.path().join("in.settle");
     std::fs::write(&copy, modified).map_err(|e| Error::io("write", &copy, e))?;
     let output = Command::new(binary)
@@ -193,21 +185,14 @@ pub fn parse_liggghts_log(log: &str) -> Result<(RunFigures, Option<f64>)> {
         if t.starts_with("Loop time of") {
             in_table = false;
             let words: Vec<&str> = t.split_whitespace().collect();
-            let num = |k: usize| {
-                words
-                    .get(k)
-                    .and_then(|w| w.trim_end_matches(',').parse::<f64>().ok())
-            };
+            let num = |k: usize| words.get(k).and_then(|w| w.trim_end_matches(',').parse::<f64>().ok());
             if let (Some(time), Some(steps), Some(atoms)) = (num(3), num(8), num(11)) {
                 figures.get_or_insert((time, steps as u64, atoms as usize));
             }
             continue;
         }
         if in_table {
-            let cols: Vec<f64> = t
-                .split_whitespace()
-                .filter_map(|w| w.parse().ok())
-                .collect();
+            let cols: Vec<f64> = t.split_whitespace().filter_map(|w| w.parse().ok()).collect();
             if cols.len() == 5 {
                 samples.push(PhysicsSample {
                     step: cols[0] as u64,
@@ -251,9 +236,7 @@ pub fn bench_dem(opts: &DemBenchOptions) -> Result<()> {
         sim.neighbor_builds()
     );
     let t = sim.timers;
-    let total = (t.force + t.neighbor + t.integrate)
-        .as_secs_f64()
-        .max(1e-12);
+    let total = (t.force + t.neighbor + t.integrate).as_secs_f64().max(1e-12);
     println!(
         "granflow: stages: force {:.1} %, neighbour {:.1} %, integrate {:.1} %",
         100.0 * t.force.as_secs_f64() / total,
@@ -277,9 +260,7 @@ pub fn bench_dem(opts: &DemBenchOptions) -> Result<()> {
     let input = match &opts.liggghts_input {
         Some(p) => p.clone(),
         None => find_liggghts_input().ok_or_else(|| {
-            Error::External(
-                "cannot find ../shared/bench/liggghts/in.settle; pass --liggghts-input".into(),
-            )
+            Error::External("cannot find ../shared/bench/liggghts/in.settle; pass --liggghts-input".into())
         })?,
     };
     let (theirs, memory_mb) = run_liggghts(&opts.liggghts_binary, &input, opts.steps)?;

@@ -56,8 +56,7 @@ pub fn checkpoint_meta(built: &BuiltScenario) -> CheckpointMeta {
             .map(|s| s.to_string())
             .collect(),
         wall_names: built.config.walls.iter().map(|w| w.name.clone()).collect(),
-        scenario_json: serde_json::to_string(&built.spec)
-            .expect("a validated spec always serialises"),
+        scenario_json: serde_json::to_string(&built.spec).expect("a validated spec always serialises"),
     }
 }
 
@@ -106,8 +105,7 @@ fn truncate_series(path: &Path, step: u64) -> Result<()> {
 pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
     let tmp = path.with_extension("tmp");
     let mut f = std::fs::File::create(&tmp).map_err(|e| Error::io("create", &tmp, e))?;
-    f.write_all(bytes)
-        .map_err(|e| Error::io("write", &tmp, e))?;
+    f.write_all(bytes).map_err(|e| Error::io("write", &tmp, e))?;
     f.sync_all().map_err(|e| Error::io("sync", &tmp, e))?;
     std::fs::rename(&tmp, path).map_err(|e| Error::io("rename", path, e))
 }
@@ -130,9 +128,7 @@ pub fn simulate(opts: &SimulateOptions) -> Result<Summary> {
             )));
         }
         Ok(_) => {}
-        Err(e) if e.kind() == std::io::ErrorKind::NotFound => {
-            write_atomic(&spec_path, meta.scenario_json.as_bytes())?
-        }
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => write_atomic(&spec_path, meta.scenario_json.as_bytes())?,
         Err(e) => return Err(Error::io("read", &spec_path, e)),
     }
 
@@ -141,10 +137,7 @@ pub fn simulate(opts: &SimulateOptions) -> Result<Summary> {
     let (mut sim, resumed_from_step) = match series.latest_valid()? {
         Some(loaded) => {
             for rejected in &loaded.rejected {
-                eprintln!(
-                    "warning: {rejected}; using {} instead",
-                    loaded.path.display()
-                );
+                eprintln!("warning: {rejected}; using {} instead", loaded.path.display());
             }
             if loaded.meta.scenario_json != meta.scenario_json {
                 return Err(Error::External(format!(
@@ -207,13 +200,10 @@ pub fn simulate(opts: &SimulateOptions) -> Result<Summary> {
     while sim.step < stop_at {
         sim.step()?;
         if sim.step % built.spec.output.series_every_steps == 0 {
-            writeln!(series_file, "{}", series_row(&sim))
-                .map_err(|e| Error::io("write", &series_path, e))?;
+            writeln!(series_file, "{}", series_row(&sim)).map_err(|e| Error::io("write", &series_path, e))?;
         }
         if sim.step % built.spec.output.checkpoint_every_steps == 0 || sim.step == total_steps {
-            series_file
-                .flush()
-                .map_err(|e| Error::io("write", &series_path, e))?;
+            series_file.flush().map_err(|e| Error::io("write", &series_path, e))?;
             series.write(&sim.snapshot(), &meta)?;
         }
         if !opts.quiet && last_report.elapsed().as_secs_f64() > 5.0 {
@@ -231,9 +221,7 @@ pub fn simulate(opts: &SimulateOptions) -> Result<Summary> {
     }
     if sim.step % built.spec.output.checkpoint_every_steps != 0 && sim.step != total_steps {
         // Stopped early (--max-steps): keep everything computed so far.
-        series_file
-            .flush()
-            .map_err(|e| Error::io("write", &series_path, e))?;
+        series_file.flush().map_err(|e| Error::io("write", &series_path, e))?;
         series.write(&sim.snapshot(), &meta)?;
     }
     let wall = start.elapsed().as_secs_f64();

@@ -88,26 +88,19 @@ fn a2_linear_spring_dashpot_matches_seed_001_appendix_b() {
     let alpha = eta / (2.0 * m * k).sqrt();
     let q = omega0 * (1.0 - alpha * alpha).sqrt();
     let (tc_theory, e_theory) = (PI / q, (-PI * alpha * omega0 / q).exp());
-    assert!(
-        (tc_theory - 9.25e-5).abs() / 9.25e-5 < 0.005,
-        "t_c = {tc_theory}"
-    );
+    assert!((tc_theory - 9.25e-5).abs() / 9.25e-5 < 0.005, "t_c = {tc_theory}");
     assert!((e_theory - 0.9487).abs() < 5e-4, "e = {e_theory}");
     let dt = tc_theory / 1000.0;
     let (tc, e) = head_on(
         &format!(
             "{{ normal: {{ linear_spring_dashpot: {{ stiffness_n_per_m: {k}, damping_kg_per_s: {eta} }} }}, tangential: {{ linear_spring_coulomb: {{ stiffness_n_per_m: {k}, damping_kg_per_s: {eta} }} }} }}"
         ),
-        &format!(
-            "density_kg_per_m3: {rho}, youngs_modulus_pa: 1.0e7, poisson_ratio: 0.3, friction_coefficient: 0.3"
-        ),
+        &format!("density_kg_per_m3: {rho}, youngs_modulus_pa: 1.0e7, poisson_ratio: 0.3, friction_coefficient: 0.3"),
         r,
         0.1,
         dt,
     );
-    println!(
-        "A2: simulated t_c = {tc:.5e} s (theory {tc_theory:.5e}), e = {e:.5} (theory {e_theory:.5})"
-    );
+    println!("A2: simulated t_c = {tc:.5e} s (theory {tc_theory:.5e}), e = {e:.5} (theory {e_theory:.5})");
     assert!((tc - tc_theory).abs() / tc_theory < 0.002);
     assert!((e - e_theory).abs() < 1e-3);
 }
@@ -200,10 +193,7 @@ fn a4_walton_braun_sliding_saturates_at_coulomb_limit() {
         }
     }
     println!("A4a: worst relative deviation of the sliding deceleration from μg: {worst_rel:.3e}");
-    assert!(
-        worst_rel < 2e-3,
-        "sliding friction is not μF_n: {worst_rel}"
-    );
+    assert!(worst_rel < 2e-3, "sliding friction is not μF_n: {worst_rel}");
     while t < 2.0 * t_slide {
         sim.step().expect("stable");
         t += dt;
@@ -216,10 +206,7 @@ fn a4_walton_braun_sliding_saturates_at_coulomb_limit() {
         w_end * r
     );
     assert!((v_end - 5.0 / 7.0 * v0).abs() / (5.0 / 7.0 * v0) < 0.01);
-    assert!(
-        (w_end * r - v_end).abs() / v_end < 0.01,
-        "rolls without slip"
-    );
+    assert!((w_end * r - v_end).abs() / v_end < 0.01, "rolls without slip");
 }
 
 /// A4 (b): an oblique, spinning impact on a wall conserves the angular momentum about the contact point,
@@ -233,8 +220,7 @@ fn a4_oblique_impact_conserves_angular_momentum_about_contact() {
     let inertia = sim.particles.inertia_kg_m2[0];
     let n = Vec3::z();
     let l = |s: &granflow::engine::Simulation| {
-        inertia * s.particles.angular_velocity_rad_per_s[0]
-            + m * r * n.cross(&s.particles.velocity_m_per_s[0])
+        inertia * s.particles.angular_velocity_rad_per_s[0] + m * r * n.cross(&s.particles.velocity_m_per_s[0])
     };
     let before = l(&sim);
     let mut touched = false;
@@ -282,10 +268,8 @@ seed: 7
         let d = (i as f64 * 39.425).sin() * 98765.43;
         *v = Vec3::new(a.fract(), c.fract(), d.fract()) * 0.5;
     }
-    let mut sim = granflow::engine::Simulation::new(b.config.clone(), particles, b.dt_s, b.rng, 1)
-        .expect("sound");
-    let energy =
-        |s: &granflow::engine::Simulation| s.particles.kinetic_energy_j() + s.elastic_energy_j();
+    let mut sim = granflow::engine::Simulation::new(b.config.clone(), particles, b.dt_s, b.rng, 1).expect("sound");
+    let energy = |s: &granflow::engine::Simulation| s.particles.kinetic_energy_j() + s.elastic_energy_j();
     let e0 = energy(&sim);
     let mut worst = 0.0f64;
     let mut collisions_seen = 0;
@@ -296,9 +280,7 @@ seed: 7
             collisions_seen += sim.contact_counts().0 + sim.contact_counts().1;
         }
     }
-    println!(
-        "A5: worst relative energy error over 1e5 steps: {worst:.3e} ({collisions_seen} contacts sampled)"
-    );
+    println!("A5: worst relative energy error over 1e5 steps: {worst:.3e} ({collisions_seen} contacts sampled)");
     assert!(collisions_seen > 100, "the test must exercise contacts");
     assert!(worst < 1e-5, "energy drift {worst}");
 }
@@ -359,8 +341,7 @@ fn a6_particle_in_rotating_drum() {
                 break;
             }
             if angle < 0.9 * slip_angle_theory {
-                worst_speed_error =
-                    worst_speed_error.max((v.norm() - omega * rho).abs() / (omega * rho));
+                worst_speed_error = worst_speed_error.max((v.norm() - omega * rho).abs() / (omega * rho));
             }
         }
     }
@@ -384,8 +365,8 @@ fn a6_particle_in_rotating_drum() {
             let x = sim.particles.position_m[0];
             let outward = Vec3::new(x.x, x.y, 0.0).normalize();
             let n = -outward;
-            let contact_v = sim.particles.velocity_m_per_s[0]
-                - (sim.particles.angular_velocity_rad_per_s[0] * r).cross(&n);
+            let contact_v =
+                sim.particles.velocity_m_per_s[0] - (sim.particles.angular_velocity_rad_per_s[0] * r).cross(&n);
             let wall_v = Vec3::z().cross(&(outward * r_drum)) * omega;
             worst_slip = worst_slip.max((contact_v - wall_v).norm() / (omega * r_drum));
         }

@@ -41,10 +41,7 @@ seed: 3
 
 fn final_state(dir: &Path) -> SimState {
     let series = CheckpointSeries::new(dir, 2);
-    let loaded = series
-        .latest_valid()
-        .expect("lists")
-        .expect("a checkpoint exists");
+    let loaded = series.latest_valid().expect("lists").expect("a checkpoint exists");
     assert!(loaded.rejected.is_empty());
     loaded.state
 }
@@ -83,10 +80,7 @@ fn restart_in_a_fresh_process_is_bit_identical() {
     );
     let middle = final_state(&dir.join("split"));
     assert_eq!(middle.step, 1500);
-    let log = run_ok(
-        &["simulate", "drum.yaml", "--out", "split", "--threads", "1"],
-        dir,
-    );
+    let log = run_ok(&["simulate", "drum.yaml", "--out", "split", "--threads", "1"], dir);
     assert!(log.contains("resuming from"), "{log}");
 
     let whole = final_state(&dir.join("whole"));
@@ -191,23 +185,13 @@ fn corrupt_newest_checkpoint_falls_back_to_the_previous_one() {
     std::fs::write(&newest, &bytes).expect("write");
     assert!(read_checkpoint(&newest).is_err());
 
-    let log = run_ok(
-        &["simulate", "drum.yaml", "--out", "run", "--max-steps", "10"],
-        dir,
-    );
-    let name = newest
-        .file_name()
-        .expect("name")
-        .to_string_lossy()
-        .into_owned();
+    let log = run_ok(&["simulate", "drum.yaml", "--out", "run", "--max-steps", "10"], dir);
+    let name = newest.file_name().expect("name").to_string_lossy().into_owned();
     assert!(
         log.contains(&name) && log.contains("using"),
         "warning names the bad file: {log}"
     );
-    assert!(
-        log.contains("step 500"),
-        "resumed from the previous checkpoint: {log}"
-    );
+    assert!(log.contains("step 500"), "resumed from the previous checkpoint: {log}");
 }
 
 #[test]
@@ -216,15 +200,7 @@ fn truncated_checkpoint_is_rejected_with_its_name() {
     let dir = tmp.path();
     std::fs::write(dir.join("drum.yaml"), DRUM).expect("write scenario");
     run_ok(
-        &[
-            "simulate",
-            "drum.yaml",
-            "--out",
-            "run",
-            "--max-steps",
-            "500",
-            "--quiet",
-        ],
+        &["simulate", "drum.yaml", "--out", "run", "--max-steps", "500", "--quiet"],
         dir,
     );
     let series = CheckpointSeries::new(dir.join("run"), 2);
@@ -232,8 +208,5 @@ fn truncated_checkpoint_is_rejected_with_its_name() {
     let bytes = std::fs::read(&newest).expect("read");
     std::fs::write(&newest, &bytes[..bytes.len() / 3]).expect("truncate");
     let err = read_checkpoint(&newest).expect_err("truncated file is rejected");
-    assert!(
-        err.to_string().contains(&*newest.to_string_lossy()),
-        "{err}"
-    );
+    assert!(err.to_string().contains(&*newest.to_string_lossy()), "{err}");
 }

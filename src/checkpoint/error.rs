@@ -22,11 +22,7 @@ pub enum CheckpointError {
     Corrupt { path: PathBuf, reason: String },
     /// The file was written with a different checkpoint format version.
     #[error("checkpoint {path} has format version {found}, this build reads version {expected}")]
-    Version {
-        path: PathBuf,
-        found: u32,
-        expected: u32,
-    },
+    Version { path: PathBuf, found: u32, expected: u32 },
     /// A file-system operation (fsync, rename, directory listing, removal) failed.
     #[error("i/o error on checkpoint {path} while {action}: {source}")]
     Io {

@@ -101,11 +101,7 @@ pub(crate) trait Visitor {
 /// Walks the datasets of [`Arrays`] in table order, filling them (the reader).
 pub(crate) trait VisitorMut {
     type Error;
-    fn visit<T: Element>(
-        &mut self,
-        spec: &DatasetSpec,
-        data: &mut Vec<T>,
-    ) -> Result<(), Self::Error>;
+    fn visit<T: Element>(&mut self, spec: &DatasetSpec, data: &mut Vec<T>) -> Result<(), Self::Error>;
 }
 
 /// Declares the dataset table: the [`Arrays`] struct (one flat, row-major `Vec` per dataset), [`DATASETS`], and
@@ -153,8 +149,7 @@ macro_rules! datasets {
     };
 }
 
-const TANGENTIAL_UNITS: &str =
-    "m (linear_spring_coulomb, mindlin: displacement) or N (walton_braun: force)";
+const TANGENTIAL_UNITS: &str = "m (linear_spring_coulomb, mindlin: displacement) or N (walton_braun: force)";
 
 datasets! {
     particle_id: u32 => "particles/id", Rows::Particles, 1, "1";
@@ -221,9 +216,7 @@ fn flatten(v: &[Vec3]) -> Vec<f64> {
 }
 
 fn unflatten(v: &[f64]) -> Vec<Vec3> {
-    v.chunks_exact(3)
-        .map(|c| Vec3::new(c[0], c[1], c[2]))
-        .collect()
+    v.chunks_exact(3).map(|c| Vec3::new(c[0], c[1], c[2])).collect()
 }
 
 /// The history columns of one contact table, filled by [`HistoryColumns::push`].
@@ -244,11 +237,8 @@ impl HistoryColumns {
         self.yielded.push(u8::from(h.yielded));
         self.tangential
             .extend_from_slice(&[h.tangential.x, h.tangential.y, h.tangential.z]);
-        self.reversal_force_n.extend_from_slice(&[
-            h.reversal_force_n.x,
-            h.reversal_force_n.y,
-            h.reversal_force_n.z,
-        ]);
+        self.reversal_force_n
+            .extend_from_slice(&[h.reversal_force_n.x, h.reversal_force_n.y, h.reversal_force_n.z]);
         self.increment_direction.extend_from_slice(&[
             h.increment_direction.x,
             h.increment_direction.y,
@@ -381,11 +371,7 @@ impl Arrays {
     pub(crate) fn into_state(self, header: &Header<'_>) -> SimState {
         let particles = Particles {
             id: self.particle_id.iter().map(|&i| ParticleId(i)).collect(),
-            species: self
-                .particle_species
-                .iter()
-                .map(|&s| SpeciesId(s))
-                .collect(),
+            species: self.particle_species.iter().map(|&s| SpeciesId(s)).collect(),
             radius_m: self.radius_m,
             mass_kg: self.mass_kg,
             inertia_kg_m2: self.inertia_kg_m2,
@@ -427,8 +413,7 @@ impl Arrays {
             .collect();
         let mut seed = [0u8; 32];
         seed.copy_from_slice(&self.rng_seed);
-        let word_pos =
-            (u128::from(self.rng_word_pos_hi[0]) << 64) | u128::from(self.rng_word_pos_lo[0]);
+        let word_pos = (u128::from(self.rng_word_pos_hi[0]) << 64) | u128::from(self.rng_word_pos_lo[0]);
         SimState {
             step: header.step,
             time_s: header.time_s,
@@ -457,10 +442,7 @@ impl Visitor for ShapeCheck {
     fn visit<T: Element>(&mut self, spec: &DatasetSpec, data: &[T]) -> Result<(), String> {
         let len = data.len();
         match spec.rows {
-            Rows::Scalar if len != 1 => Err(format!(
-                "/{} must be a scalar, has {len} elements",
-                spec.path
-            )),
+            Rows::Scalar if len != 1 => Err(format!("/{} must be a scalar, has {len} elements", spec.path)),
             Rows::Fixed(n) if len != n * spec.width => Err(format!(
                 "/{} must have {} elements, has {len}",
                 spec.path,
@@ -477,10 +459,7 @@ impl Visitor for ShapeCheck {
                 if rows == expected {
                     Ok(())
                 } else {
-                    Err(format!(
-                        "/{} has {rows} rows but /{first} has {expected}",
-                        spec.path
-                    ))
+                    Err(format!("/{} has {rows} rows but /{first} has {expected}", spec.path))
                 }
             }
         }
@@ -564,8 +543,7 @@ const SEAL_MAGIC: &str = "granflow-checkpoint seal v1\n";
 
 /// The userblock: magic line, `hdf5_bytes=<decimal>`, `file_xxh3_64=0x<16 hex digits>`, zero padding.
 fn seal_block(hdf5_bytes: u64, hash: u64) -> Vec<u8> {
-    let mut block =
-        format!("{SEAL_MAGIC}hdf5_bytes={hdf5_bytes}\nfile_xxh3_64={hash:#018x}\n").into_bytes();
+    let mut block = format!("{SEAL_MAGIC}hdf5_bytes={hdf5_bytes}\nfile_xxh3_64={hash:#018x}\n").into_bytes();
     block.resize(SEAL_BYTES as usize, 0);
     block
 }
@@ -601,11 +579,7 @@ fn hash_rest(file: &mut File) -> std::io::Result<(u64, u64)> {
 /// userblock, writes the seal into it and fsyncs the file.
 pub(crate) fn seal(path: &Path) -> Result<(), CheckpointError> {
     let io = |e: std::io::Error| CheckpointError::io(path, "sealing the file", e);
-    let mut file = OpenOptions::new()
-        .read(true)
-        .write(true)
-        .open(path)
-        .map_err(io)?;
+    let mut file = OpenOptions::new().read(true).write(true).open(path).map_err(io)?;
     file.seek(SeekFrom::Start(SEAL_BYTES)).map_err(io)?;
     let (hash, len) = hash_rest(&mut file).map_err(io)?;
     file.seek(SeekFrom::Start(0)).map_err(io)?;
@@ -637,9 +611,7 @@ pub(crate) fn verify_seal(path: &Path) -> Result<(), CheckpointError> {
         .ok_or_else(|| corrupt("the seal block is damaged".to_string()))?;
     let expected = SEAL_BYTES.saturating_add(hdf5_bytes);
     if len < expected {
-        return Err(corrupt(format!(
-            "truncated ({len} bytes, {expected} written)"
-        )));
+        return Err(corrupt(format!("truncated ({len} bytes, {expected} written)")));
     }
     if len > expected {
         return Err(corrupt(format!(

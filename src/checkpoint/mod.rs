@@ -22,8 +22,8 @@ use hdf5::{Datatype, H5Type, Location};
 
 pub use error::CheckpointError;
 use layout::{
-    Arrays, DatasetSpec, Element, FORMAT_NAME, GROUPS, Header, Rows, SEAL_BYTES, Visitor,
-    VisitorMut, checksum, seal, verify_seal,
+    Arrays, DatasetSpec, Element, FORMAT_NAME, GROUPS, Header, Rows, SEAL_BYTES, Visitor, VisitorMut, checksum, seal,
+    verify_seal,
 };
 pub use series::{CheckpointSeries, LoadedCheckpoint};
 
@@ -56,11 +56,7 @@ fn tmp_path(path: &Path) -> PathBuf {
 /// Writes `state` and `meta` to `path` atomically: to `<path>.tmp`, flush and close, seal (file checksum in the
 /// userblock) and fsync the file, rename it over `path`, fsync the directory. On failure the temporary file is
 /// removed and an existing `path` is left untouched.
-pub fn write_checkpoint(
-    path: &Path,
-    state: &SimState,
-    meta: &CheckpointMeta,
-) -> Result<(), CheckpointError> {
+pub fn write_checkpoint(path: &Path, state: &SimState, meta: &CheckpointMeta) -> Result<(), CheckpointError> {
     let invalid = |reason: String| CheckpointError::InvalidState {
         path: path.to_path_buf(),
         reason,
@@ -100,8 +96,7 @@ pub fn write_checkpoint(
 /// Seals and fsyncs `tmp`, renames it over `path` and fsyncs the directory.
 fn commit(tmp: &Path, path: &Path) -> Result<(), CheckpointError> {
     seal(tmp)?;
-    std::fs::rename(tmp, path)
-        .map_err(|e| CheckpointError::io(path, "renaming the temporary file into place", e))?;
+    std::fs::rename(tmp, path).map_err(|e| CheckpointError::io(path, "renaming the temporary file into place", e))?;
     let dir = match path.parent() {
         Some(d) if !d.as_os_str().is_empty() => d,
         _ => Path::new("."),
@@ -112,12 +107,7 @@ fn commit(tmp: &Path, path: &Path) -> Result<(), CheckpointError> {
 }
 
 /// Creates the HDF5 file `tmp` with the whole checkpoint, then flushes and closes it.
-fn write_hdf5(
-    tmp: &Path,
-    header: &Header<'_>,
-    arrays: &Arrays,
-    sum: u64,
-) -> Result<(), CheckpointError> {
+fn write_hdf5(tmp: &Path, header: &Header<'_>, arrays: &Arrays, sum: u64) -> Result<(), CheckpointError> {
     let err = |context: &'static str| move |e: hdf5::Error| CheckpointError::hdf5(tmp, context, e);
     let file = hdf5::File::with_options()
         .with_fcpl(|p| p.userblock(SEAL_BYTES))
@@ -142,10 +132,8 @@ fn write_contents(
     };
     let meta = header.meta;
     put_str_attr(file, "format", FORMAT_NAME).map_err(attr_err("format"))?;
-    put_scalar_attr(file, "format_version", header.format_version)
-        .map_err(attr_err("format_version"))?;
-    put_str_attr(file, "engine_version", &meta.engine_version)
-        .map_err(attr_err("engine_version"))?;
+    put_scalar_attr(file, "format_version", header.format_version).map_err(attr_err("format_version"))?;
+    put_str_attr(file, "engine_version", &meta.engine_version).map_err(attr_err("engine_version"))?;
     put_scalar_attr(file, "step", header.step).map_err(attr_err("step"))?;
     put_scalar_attr(file, "time_s", header.time_s).map_err(attr_err("time_s"))?;
     put_scalar_attr(file, "dt_s", header.dt_s).map_err(attr_err("dt_s"))?;
@@ -174,14 +162,8 @@ fn put_str_attr(loc: &Location, name: &str, value: &str) -> hdf5::Result<()> {
 }
 
 fn put_str_list_attr(loc: &Location, name: &str, values: &[String]) -> hdf5::Result<()> {
-    let values = values
-        .iter()
-        .map(|s| vlen(s))
-        .collect::<hdf5::Result<Vec<_>>>()?;
-    let attr = loc
-        .new_attr::<VarLenUnicode>()
-        .shape([values.len()])
-        .create(name)?;
+    let values = values.iter().map(|s| vlen(s)).collect::<hdf5::Result<Vec<_>>>()?;
+    let attr = loc.new_attr::<VarLenUnicode>().shape([values.len()]).create(name)?;
     if values.is_empty() {
         Ok(())
     } else {
@@ -199,8 +181,7 @@ impl Visitor for Writer<'_> {
     type Error = CheckpointError;
 
     fn visit<T: Element>(&mut self, spec: &DatasetSpec, data: &[T]) -> Result<(), CheckpointError> {
-        let err =
-            |e: hdf5::Error| CheckpointError::hdf5(self.path, format!("writing /{}", spec.path), e);
+        let err = |e: hdf5::Error| CheckpointError::hdf5(self.path, format!("writing /{}", spec.path), e);
         let shape = spec.shape(data.len());
         let ds = self
             .file
@@ -226,8 +207,7 @@ pub fn read_checkpoint(path: &Path) -> Result<(SimState, CheckpointMeta), Checkp
     let file_len = std::fs::metadata(path)
         .map_err(|e| CheckpointError::io(path, "reading the file's metadata", e))?
         .len();
-    let file =
-        hdf5::File::open(path).map_err(|e| CheckpointError::hdf5(path, "opening the file", e))?;
+    let file = hdf5::File::open(path).map_err(|e| CheckpointError::hdf5(path, "opening the file", e))?;
     let mut reader = Reader {
         file: &file,
         path,
@@ -300,8 +280,7 @@ impl Reader<'_> {
 
     /// Fails unless `actual` is exactly the type `T` is written as.
     fn check_type<T: H5Type>(&self, actual: &Datatype, what: &str) -> Result<(), CheckpointError> {
-        let expected = Datatype::from_type::<T>()
-            .map_err(self.hdf5_err(format!("building the type of {what}")))?;
+        let expected = Datatype::from_type::<T>().map_err(self.hdf5_err(format!("building the type of {what}")))?;
         if *actual == expected {
             Ok(())
         } else {
@@ -310,11 +289,7 @@ impl Reader<'_> {
     }
 
     /// Opens root attribute `name` after checking that it exists and has type `T` and rank `rank`.
-    fn attr<T: H5Type>(
-        &self,
-        name: &str,
-        rank: usize,
-    ) -> Result<(hdf5::Attribute, Vec<usize>), CheckpointError> {
+    fn attr<T: H5Type>(&self, name: &str, rank: usize) -> Result<(hdf5::Attribute, Vec<usize>), CheckpointError> {
         let what = format!("root attribute {name}");
         let names = self
             .file
@@ -323,10 +298,7 @@ impl Reader<'_> {
         if !names.iter().any(|n| n == name) {
             return Err(self.corrupt(format!("missing {what}")));
         }
-        let attr = self
-            .file
-            .attr(name)
-            .map_err(self.hdf5_err(format!("opening {what}")))?;
+        let attr = self.file.attr(name).map_err(self.hdf5_err(format!("opening {what}")))?;
         let dtype = attr
             .dtype()
             .map_err(self.hdf5_err(format!("reading the type of {what}")))?;
@@ -371,11 +343,7 @@ impl Reader<'_> {
 impl VisitorMut for Reader<'_> {
     type Error = CheckpointError;
 
-    fn visit<T: Element>(
-        &mut self,
-        spec: &DatasetSpec,
-        data: &mut Vec<T>,
-    ) -> Result<(), CheckpointError> {
+    fn visit<T: Element>(&mut self, spec: &DatasetSpec, data: &mut Vec<T>) -> Result<(), CheckpointError> {
         let what = format!("dataset /{}", spec.path);
         if !self.file.link_exists(spec.path) {
             return Err(self.corrupt(format!("missing {what}")));
@@ -400,10 +368,7 @@ impl VisitorMut for Reader<'_> {
             _ => false,
         };
         if !shape_ok {
-            return Err(self.corrupt(format!(
-                "{what} has shape {shape:?}, expected {}",
-                expected_shape(spec)
-            )));
+            return Err(self.corrupt(format!("{what} has shape {shape:?}, expected {}", expected_shape(spec))));
         }
         let len = shape.iter().try_fold(1usize, |acc, &d| acc.checked_mul(d));
         let bytes = len.and_then(|n| n.checked_mul(std::mem::size_of::<T>()));
@@ -427,10 +392,7 @@ impl VisitorMut for Reader<'_> {
             reader.read_raw::<T>().map_err(self.hdf5_err(context))?
         };
         if data.len() != len {
-            return Err(self.corrupt(format!(
-                "{what} read {} elements, expected {len}",
-                data.len()
-            )));
+            return Err(self.corrupt(format!("{what} read {} elements, expected {len}", data.len())));
         }
         Ok(())
     }
@@ -491,19 +453,12 @@ mod tests {
             p.radius_m.push(1.0e-3 * (1.0 + 0.1234567 * f));
             p.mass_kg.push(2.5e-6 * f.sqrt());
             p.inertia_kg_m2.push(1.0e-12 / 3.0 * f);
-            p.position_m
-                .push(v(0.01 * f / 7.0, -0.003 * f, 0.1 + 1.0 / (f + 13.0)));
-            p.velocity_m_per_s
-                .push(v(-0.0, 1.0e-310 * f, 0.577_215_664 * f));
-            p.angular_velocity_rad_per_s
-                .push(v(SUBNORMAL, -SUBNORMAL * f, 3.0 / f));
-            p.force_n
-                .push(v(f * 1.0e-3 / 3.0, -9.81 * f, f64::MIN_POSITIVE));
-            p.torque_n_m.push(v(
-                -1.0e-9 * f,
-                f64::from_bits(0x7ff8_0000_dead_beef),
-                f64::MAX / f,
-            ));
+            p.position_m.push(v(0.01 * f / 7.0, -0.003 * f, 0.1 + 1.0 / (f + 13.0)));
+            p.velocity_m_per_s.push(v(-0.0, 1.0e-310 * f, 0.577_215_664 * f));
+            p.angular_velocity_rad_per_s.push(v(SUBNORMAL, -SUBNORMAL * f, 3.0 / f));
+            p.force_n.push(v(f * 1.0e-3 / 3.0, -9.81 * f, f64::MIN_POSITIVE));
+            p.torque_n_m
+                .push(v(-1.0e-9 * f, f64::from_bits(0x7ff8_0000_dead_beef), f64::MAX / f));
         }
         p.position_m[2].x = DISTINCTIVE;
         let contacts = ContactStore {
@@ -550,10 +505,7 @@ mod tests {
     }
 
     fn vecs_differ(a: &[Vec3], b: &[Vec3]) -> bool {
-        a.len() != b.len()
-            || a.iter()
-                .zip(b)
-                .any(|(x, y)| f64s_differ(x.as_slice(), y.as_slice()))
+        a.len() != b.len() || a.iter().zip(b).any(|(x, y)| f64s_differ(x.as_slice(), y.as_slice()))
     }
 
     fn history_diff(a: &ContactHistory, b: &ContactHistory) -> Option<&'static str> {
@@ -624,7 +576,10 @@ mod tests {
         let mut c = a.clone();
         c.contacts.walls[1].2.max_overlap_m += 1e-20;
         let diff = crate::engine::state::first_difference(&a, &c).expect("differs");
-        assert!(diff.starts_with("contacts.walls[1]") && diff.contains("max_overlap_m"), "{diff}");
+        assert!(
+            diff.starts_with("contacts.walls[1]") && diff.contains("max_overlap_m"),
+            "{diff}"
+        );
     }
 
     #[test]
@@ -667,10 +622,7 @@ mod tests {
         std::fs::write(&path, &bytes[..bytes.len() / 2]).expect("truncate");
         let err = read_checkpoint(&path).expect_err("a truncated file must not read");
         assert_eq!(err.path(), path);
-        assert!(
-            err.to_string().contains(&path.display().to_string()),
-            "{err}"
-        );
+        assert!(err.to_string().contains(&path.display().to_string()), "{err}");
     }
 
     #[test]
@@ -705,10 +657,7 @@ mod tests {
         seal(&path).expect("reseal");
         let err = read_checkpoint(&path).expect_err("changed content must be detected");
         assert!(matches!(err, CheckpointError::Corrupt { .. }), "{err:?}");
-        assert!(
-            err.to_string().contains("content checksum mismatch"),
-            "{err}"
-        );
+        assert!(err.to_string().contains("content checksum mismatch"), "{err}");
     }
 
     #[test]
@@ -721,10 +670,7 @@ mod tests {
         seal(&path).expect("reseal");
         let err = read_checkpoint(&path).expect_err("libhdf5 must refuse a truncated file");
         assert!(matches!(err, CheckpointError::Hdf5 { .. }), "{err:?}");
-        assert!(
-            err.to_string().contains(&path.display().to_string()),
-            "{err}"
-        );
+        assert!(err.to_string().contains(&path.display().to_string()), "{err}");
     }
 
     #[test]
@@ -741,18 +687,12 @@ mod tests {
             bytes[k] ^= 1 << (k % 8);
             std::fs::write(&path, &bytes).expect("write file");
             let err = read_checkpoint(&path).expect_err("a flipped bit must be detected");
-            assert!(
-                matches!(err, CheckpointError::Corrupt { .. }),
-                "byte {k}: {err:?}"
-            );
+            assert!(matches!(err, CheckpointError::Corrupt { .. }), "byte {k}: {err:?}");
         }
         for len in (0..orig.len()).step_by(97) {
             std::fs::write(&path, &orig[..len]).expect("write file");
             let err = read_checkpoint(&path).expect_err("a cut file must be detected");
-            assert!(
-                matches!(err, CheckpointError::Corrupt { .. }),
-                "length {len}: {err:?}"
-            );
+            assert!(matches!(err, CheckpointError::Corrupt { .. }), "length {len}: {err:?}");
         }
     }
 
@@ -789,10 +729,7 @@ mod tests {
         let path = dir.path().join("other.h5");
         {
             let file = hdf5::File::create(&path).expect("create");
-            file.new_dataset::<f64>()
-                .shape([3])
-                .create("x")
-                .expect("dataset");
+            file.new_dataset::<f64>().shape([3]).create("x").expect("dataset");
         }
         let err = read_checkpoint(&path).expect_err("not a checkpoint");
         assert!(err.to_string().contains("no checkpoint seal"), "{err}");
@@ -803,17 +740,11 @@ mod tests {
                 .with_fcpl(|p| p.userblock(SEAL_BYTES))
                 .create(&path)
                 .expect("create");
-            file.new_dataset::<f64>()
-                .shape([3])
-                .create("x")
-                .expect("dataset");
+            file.new_dataset::<f64>().shape([3]).create("x").expect("dataset");
         }
         seal(&path).expect("seal");
         let err = read_checkpoint(&path).expect_err("not a checkpoint");
-        assert!(
-            err.to_string().contains("missing root attribute format"),
-            "{err}"
-        );
+        assert!(err.to_string().contains("missing root attribute format"), "{err}");
     }
 
     #[test]
@@ -822,12 +753,8 @@ mod tests {
         let path = dir.path().join("ckpt-000000000001.h5");
         let mut state = sample_state();
         state.contacts.walls[0].1 = WallId(5);
-        let err =
-            write_checkpoint(&path, &state, &sample_meta()).expect_err("wall 5 does not exist");
-        assert!(
-            matches!(err, CheckpointError::InvalidState { .. }),
-            "{err:?}"
-        );
+        let err = write_checkpoint(&path, &state, &sample_meta()).expect_err("wall 5 does not exist");
+        assert!(matches!(err, CheckpointError::InvalidState { .. }), "{err:?}");
         let mut state = sample_state();
         state.particles.mass_kg.pop();
         let err = write_checkpoint(&path, &state, &sample_meta()).expect_err("mass_kg is short");
@@ -846,12 +773,7 @@ mod tests {
             let path = series.write(&state, &meta).expect("write");
             assert_eq!(path, series.path_for_step(step));
         }
-        let steps: Vec<u64> = series
-            .list()
-            .expect("list")
-            .into_iter()
-            .map(|(s, _)| s)
-            .collect();
+        let steps: Vec<u64> = series.list().expect("list").into_iter().map(|(s, _)| s).collect();
         assert_eq!(steps, [400, 300, 200]);
         assert!(!series.path_for_step(100).exists());
 
@@ -866,11 +788,7 @@ mod tests {
         assert_eq!(loaded.meta, meta);
         assert_eq!(loaded.rejected.len(), 1);
         assert_eq!(loaded.rejected[0].path(), newest);
-        assert!(
-            loaded.rejected[0]
-                .to_string()
-                .contains("ckpt-000000000400.h5")
-        );
+        assert!(loaded.rejected[0].to_string().contains("ckpt-000000000400.h5"));
 
         // Truncating the next one as well falls back to 200, with both rejections listed newest first.
         let p300 = series.path_for_step(300);
@@ -914,12 +832,7 @@ mod tests {
         series.write(&state, &sample_meta()).expect("write");
         let tmp = tmp_path(&series.path_for_step(20));
         std::fs::write(&tmp, b"half-written").expect("write tmp");
-        for other in [
-            "notes.txt",
-            "ckpt-.h5",
-            "ckpt-12x.h5",
-            "ckpt-000000000030.h5.bak",
-        ] {
+        for other in ["notes.txt", "ckpt-.h5", "ckpt-12x.h5", "ckpt-000000000030.h5.bak"] {
             std::fs::write(dir.path().join(other), b"x").expect("write other");
         }
         std::fs::create_dir(series.path_for_step(40)).expect("mkdir");
@@ -961,9 +874,7 @@ mod tests {
             out.extend(data);
         }
         fn f(v: impl IntoIterator<Item = f64>) -> Vec<u8> {
-            v.into_iter()
-                .flat_map(|x| x.to_bits().to_le_bytes())
-                .collect()
+            v.into_iter().flat_map(|x| x.to_bits().to_le_bytes()).collect()
         }
         fn v3(v: &[Vec3]) -> Vec<u8> {
             f(v.iter().flat_map(|x| [x.x, x.y, x.z]))
@@ -1000,18 +911,8 @@ mod tests {
         let species: Vec<u8> = p.species.iter().flat_map(|i| i.0.to_le_bytes()).collect();
         ds(&mut b, "particles/id", &[n], &ids);
         ds(&mut b, "particles/species", &[n], &species);
-        ds(
-            &mut b,
-            "particles/radius_m",
-            &[n],
-            &f(p.radius_m.iter().copied()),
-        );
-        ds(
-            &mut b,
-            "particles/mass_kg",
-            &[n],
-            &f(p.mass_kg.iter().copied()),
-        );
+        ds(&mut b, "particles/radius_m", &[n], &f(p.radius_m.iter().copied()));
+        ds(&mut b, "particles/mass_kg", &[n], &f(p.mass_kg.iter().copied()));
         ds(
             &mut b,
             "particles/inertia_kg_m2",
@@ -1019,19 +920,9 @@ mod tests {
             &f(p.inertia_kg_m2.iter().copied()),
         );
         ds(&mut b, "particles/position_m", &[n, 3], &v3(&p.position_m));
-        ds(
-            &mut b,
-            "particles/velocity_m_per_s",
-            &[n, 3],
-            &v3(&p.velocity_m_per_s),
-        );
+        ds(&mut b, "particles/velocity_m_per_s", &[n, 3], &v3(&p.velocity_m_per_s));
         let omega = v3(&p.angular_velocity_rad_per_s);
-        ds(
-            &mut b,
-            "particles/angular_velocity_rad_per_s",
-            &[n, 3],
-            &omega,
-        );
+        ds(&mut b, "particles/angular_velocity_rad_per_s", &[n, 3], &omega);
         ds(&mut b, "particles/force_n", &[n, 3], &v3(&p.force_n));
         ds(&mut b, "particles/torque_n_m", &[n, 3], &v3(&p.torque_n_m));
         // (group, i bytes, partner bytes, histories)
@@ -1039,64 +930,27 @@ mod tests {
         let tables: [Table; 2] = [
             (
                 "pairs",
-                state
-                    .contacts
-                    .pairs
-                    .iter()
-                    .flat_map(|c| c.0.0.to_le_bytes())
-                    .collect(),
-                state
-                    .contacts
-                    .pairs
-                    .iter()
-                    .flat_map(|c| c.1.0.to_le_bytes())
-                    .collect(),
+                state.contacts.pairs.iter().flat_map(|c| c.0.0.to_le_bytes()).collect(),
+                state.contacts.pairs.iter().flat_map(|c| c.1.0.to_le_bytes()).collect(),
                 state.contacts.pairs.iter().map(|c| c.2).collect(),
             ),
             (
                 "walls",
-                state
-                    .contacts
-                    .walls
-                    .iter()
-                    .flat_map(|c| c.0.0.to_le_bytes())
-                    .collect(),
-                state
-                    .contacts
-                    .walls
-                    .iter()
-                    .flat_map(|c| c.1.0.to_le_bytes())
-                    .collect(),
+                state.contacts.walls.iter().flat_map(|c| c.0.0.to_le_bytes()).collect(),
+                state.contacts.walls.iter().flat_map(|c| c.1.0.to_le_bytes()).collect(),
                 state.contacts.walls.iter().map(|c| c.2).collect(),
             ),
         ];
         for (table, i, partner, h) in tables {
             let m = h.len();
             let partner_name = if table == "pairs" { "j" } else { "wall" };
-            let flag = |get: fn(&ContactHistory) -> bool| -> Vec<u8> {
-                h.iter().map(|x| u8::from(get(x))).collect()
-            };
+            let flag = |get: fn(&ContactHistory) -> bool| -> Vec<u8> { h.iter().map(|x| u8::from(get(x))).collect() };
             let vec = |get: fn(&ContactHistory) -> Vec3| v3(&h.iter().map(get).collect::<Vec<_>>());
             let scalar = |get: fn(&ContactHistory) -> f64| f(h.iter().map(get));
             ds(&mut b, &format!("contacts/{table}/i"), &[m], &i);
-            ds(
-                &mut b,
-                &format!("contacts/{table}/{partner_name}"),
-                &[m],
-                &partner,
-            );
-            ds(
-                &mut b,
-                &format!("contacts/{table}/active"),
-                &[m],
-                &flag(|x| x.active),
-            );
-            ds(
-                &mut b,
-                &format!("contacts/{table}/yielded"),
-                &[m],
-                &flag(|x| x.yielded),
-            );
+            ds(&mut b, &format!("contacts/{table}/{partner_name}"), &[m], &partner);
+            ds(&mut b, &format!("contacts/{table}/active"), &[m], &flag(|x| x.active));
+            ds(&mut b, &format!("contacts/{table}/yielded"), &[m], &flag(|x| x.yielded));
             ds(
                 &mut b,
                 &format!("contacts/{table}/tangential"),

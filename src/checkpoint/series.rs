@@ -67,19 +67,12 @@ impl CheckpointSeries {
     /// step), then deletes the oldest checkpoints beyond `keep`, only after the new one is renamed into place. The
     /// file just written is never deleted, even if files of later steps (from an abandoned continuation of the
     /// run) are present. Returns the path written.
-    pub fn write(
-        &self,
-        state: &SimState,
-        meta: &CheckpointMeta,
-    ) -> Result<PathBuf, CheckpointError> {
+    pub fn write(&self, state: &SimState, meta: &CheckpointMeta) -> Result<PathBuf, CheckpointError> {
         std::fs::create_dir_all(&self.dir)
             .map_err(|e| CheckpointError::io(&self.dir, "creating the checkpoint directory", e))?;
         let path = self.path_for_step(state.step);
         write_checkpoint(&path, state, meta)?;
-        let others = self
-            .list()?
-            .into_iter()
-            .filter(|(step, _)| *step != state.step);
+        let others = self.list()?.into_iter().filter(|(step, _)| *step != state.step);
         for (_, old) in others.skip(self.keep - 1) {
             match std::fs::remove_file(&old) {
                 Ok(()) => {}
@@ -98,18 +91,12 @@ impl CheckpointSeries {
             Ok(entries) => entries,
             Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(Vec::new()),
             Err(e) => {
-                return Err(CheckpointError::io(
-                    &self.dir,
-                    "listing the checkpoint directory",
-                    e,
-                ));
+                return Err(CheckpointError::io(&self.dir, "listing the checkpoint directory", e));
             }
         };
         let mut found = Vec::new();
         for entry in entries {
-            let entry = entry.map_err(|e| {
-                CheckpointError::io(&self.dir, "listing the checkpoint directory", e)
-            })?;
+            let entry = entry.map_err(|e| CheckpointError::io(&self.dir, "listing the checkpoint directory", e))?;
             let Some(step) = entry.file_name().to_str().and_then(parse_step) else {
                 continue;
             };
@@ -132,10 +119,7 @@ impl CheckpointSeries {
             match read_checkpoint(&path) {
                 Ok((state, _)) if state.step != step => rejected.push(CheckpointError::corrupt(
                     &path,
-                    format!(
-                        "the file name says step {step} but the state is at step {}",
-                        state.step
-                    ),
+                    format!("the file name says step {step} but the state is at step {}", state.step),
                 )),
                 Ok((state, meta)) => {
                     return Ok(Some(LoadedCheckpoint {

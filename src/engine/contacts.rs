@@ -32,11 +32,14 @@ pub struct ContactStore {
 }
 
 /// Histories aligned with a [`NeighborList`]: `pair[k]` belongs to slot k of `partner`, `wall[k]` to slot k of
-/// `wall_partner`.
+/// `wall_partner`. `pair_touching[k]` mirrors `pair[k].active` in a dense array: the force loop examines every
+/// candidate each step but touches the (large) history only for contacts, which keeps it out of cache otherwise.
 #[derive(Debug, Clone, Default)]
 pub struct AlignedHistory {
     pub pair: Vec<ContactHistory>,
     pub wall: Vec<ContactHistory>,
+    pub pair_touching: Vec<bool>,
+    pub wall_touching: Vec<bool>,
 }
 
 impl AlignedHistory {
@@ -46,21 +49,17 @@ impl AlignedHistory {
         let mut store = ContactStore::default();
         for i in 0..n {
             for k in list.pairs_of(i) {
-                if self.pair[k].active {
-                    store.pairs.push((
-                        ParticleId(i as u32),
-                        ParticleId(list.partner[k]),
-                        self.pair[k],
-                    ));
+                if self.pair_touching[k] {
+                    store
+                        .pairs
+                        .push((ParticleId(i as u32), ParticleId(list.partner[k]), self.pair[k]));
                 }
             }
             for k in list.walls_of(i) {
-                if self.wall[k].active {
-                    store.walls.push((
-                        ParticleId(i as u32),
-                        WallId(list.wall_partner[k]),
-                        self.wall[k],
-                    ));
+                if self.wall_touching[k] {
+                    store
+                        .walls
+                        .push((ParticleId(i as u32), WallId(list.wall_partner[k]), self.wall[k]));
                 }
             }
         }
@@ -102,10 +101,22 @@ impl AlignedHistory {
             }
         }
         orphans += next_pair.count() + next_wall.count();
-        (AlignedHistory { pair, wall }, orphans)
+        let pair_touching = pair.iter().map(|h| h.active).collect();
+        let wall_touching = wall.iter().map(|h| h.active).collect();
+        (
+            AlignedHistory {
+                pair,
+                wall,
+                pair_touching,
+                wall_touching,
+            },
+            orphans,
+        )
     }
 
     pub fn heap_bytes(&self) -> usize {
         (self.pair.capacity() + self.wall.capacity()) * std::mem::size_of::<ContactHistory>()
+            + self.pair_touching.capacity()
+            + self.wall_touching.capacity()
     }
 }

@@ -67,8 +67,7 @@ impl WorstOverlap {
 
     fn max(self, other: WorstOverlap) -> WorstOverlap {
         // Ties resolve to the lower particle index so the report does not depend on the thread count.
-        if other.ratio > self.ratio || (other.ratio == self.ratio && other.particle < self.particle)
-        {
+        if other.ratio > self.ratio || (other.ratio == self.ratio && other.particle < self.particle) {
             other
         } else {
             self
@@ -109,40 +108,35 @@ impl Context<'_> {
         &self,
         i: usize,
         j: usize,
+        touching: &mut bool,
         hist: &mut ContactHistory,
         worst: &mut WorstOverlap,
     ) -> Option<PairResult> {
         let p = self.p;
-        let d = self
-            .config
-            .domain
-            .separation(&p.position_m[i], &p.position_m[j]);
+        let d = self.config.domain.separation(&p.position_m[i], &p.position_m[j]);
         let dist2 = d.norm_squared();
         let (ri, rj) = (p.radius_m[i], p.radius_m[j]);
         let reach = ri + rj;
         if dist2 >= reach * reach {
-            if hist.active {
+            if *touching {
+                *touching = false;
                 *hist = ContactHistory::INACTIVE;
             }
             return None;
         }
+        *touching = true;
         let dist = dist2.sqrt();
         let n = d / dist;
         let overlap = reach - dist;
         worst.note(overlap, ri.min(rj), i, j as u32);
-        let (wi, wj) = (
-            p.angular_velocity_rad_per_s[i],
-            p.angular_velocity_rad_per_s[j],
-        );
+        let (wi, wj) = (p.angular_velocity_rad_per_s[i], p.angular_velocity_rad_per_s[j]);
         let (mi, mj) = (p.mass_kg[i], p.mass_kg[j]);
         let k = ContactKinematics {
             normal: n,
             overlap_m: overlap,
             effective_radius_m: ri * rj / reach,
             effective_mass_kg: mi * mj / (mi + mj),
-            contact_velocity: p.velocity_m_per_s[i]
-                - p.velocity_m_per_s[j]
-                - (wi * ri + wj * rj).cross(&n),
+            contact_velocity: p.velocity_m_per_s[i] - p.velocity_m_per_s[j] - (wi * ri + wj * rj).cross(&n),
             relative_angular_velocity: wi - wj,
         };
         let mat = self.table.get(p.species[i], p.species[j]);
@@ -157,10 +151,12 @@ impl Context<'_> {
 
     /// Adds the wall contacts of particle i to (f, t), in ascending wall order.
     #[inline(always)]
+    #[allow(clippy::too_many_arguments)]
     fn walls(
         &self,
         i: usize,
         wall_ids: &[u16],
+        touching: &mut [bool],
         hist: &mut [ContactHistory],
         f: &mut Vec3,
         t: &mut Vec3,
@@ -169,16 +165,18 @@ impl Context<'_> {
         let p = self.p;
         let x = p.position_m[i];
         let ri = p.radius_m[i];
-        for (h, &w) in hist.iter_mut().zip(wall_ids) {
+        for ((h, on), &w) in hist.iter_mut().zip(touching.iter_mut()).zip(wall_ids) {
             let wall = &self.config.walls[w as usize];
             let prox = wall.proximity(&x, self.wall_angle[w as usize]);
             let overlap = ri - prox.gap_m;
             if overlap <= 0.0 {
-                if h.active {
+                if *on {
+                    *on = false;
                     *h = ContactHistory::INACTIVE;
                 }
                 continue;
             }
+            *on = true;
             worst.note(overlap, ri, i, u32::MAX - w as u32);
             let n = prox.normal;
             let wi = p.angular_velocity_rad_per_s[i];
@@ -252,7 +250,7 @@ fn serial(
         let slots = list.pairs_of(i);
         for (k, &j) in slots.clone().zip(&list.partner[slots]) {
             let j = j as usize;
-            if let Some(r) = ctx.pair(i, j, &mut history.pair[k], &mut worst) {
+            if let Some(r) = ctx.pair(i, j, &mut history.pair_touching[k], &mut history.pair[k], &mut worst) {
                 force[i] += r.force;
                 force[j] -= r.force;
                 torque[i] += r.torque_i;
@@ -264,6 +262,7 @@ fn serial(
         ctx.walls(
             i,
             &list.wall_partner[walls.clone()],
+            &mut history.wall_touching[walls.clone()],
             &mut history.wall[walls],
             &mut f,
             &mut t,
@@ -301,25 +300,21 @@ fn parallel(
     buffers.force_on_i.resize(n_slots, Vec3::zeros());
     buffers.torque_on_i.resize(n_slots, Vec3::zeros());
     buffers.torque_on_j.resize(n_slots, Vec3::zeros());
-    let chunk_bounds: Vec<usize> = (1..=n.div_ceil(CHUNK))
-        .map(|c| (c * CHUNK).min(n))
-        .collect();
+    let chunk_bounds: Vec<usize> = (1..=n.div_ceil(CHUNK)).map(|c| (c * CHUNK).min(n)).collect();
 
     // Pass 1: every pair slot, in parallel by chunks of first particles.
-    let pair_ends: Vec<usize> = chunk_bounds
-        .iter()
-        .map(|&hi| list.start[hi] as usize)
-        .collect();
+    let pair_ends: Vec<usize> = chunk_bounds.iter().map(|&hi| list.start[hi] as usize).collect();
     let hist_parts = split_by_offsets(&mut history.pair, &pair_ends);
+    let touching_parts = split_by_offsets(&mut history.pair_touching, &pair_ends);
     let f_parts = split_by_offsets(&mut buffers.force_on_i, &pair_ends);
     let ti_parts = split_by_offsets(&mut buffers.torque_on_i, &pair_ends);
     let tj_parts = split_by_offsets(&mut buffers.torque_on_j, &pair_ends);
     let worst_pairs = hist_parts
         .into_par_iter()
-        .zip(f_parts)
-        .zip(ti_parts.into_par_iter().zip(tj_parts))
+        .zip(touching_parts)
+        .zip(f_parts.into_par_iter().zip(ti_parts.into_par_iter().zip(tj_parts)))
         .enumerate()
-        .map(|(c, ((hist, fb), (tib, tjb)))| {
+        .map(|(c, ((hist, touching), (fb, (tib, tjb))))| {
             let lo = c * CHUNK;
             let hi = chunk_bounds[c];
             let base = list.start[lo] as usize;
@@ -328,7 +323,7 @@ fn parallel(
                 for k in list.pairs_of(i) {
                     let j = list.partner[k] as usize;
                     let local = k - base;
-                    if let Some(r) = ctx.pair(i, j, &mut hist[local], &mut worst) {
+                    if let Some(r) = ctx.pair(i, j, &mut touching[local], &mut hist[local], &mut worst) {
                         fb[local] = r.force;
                         tib[local] = r.torque_i;
                         tjb[local] = r.torque_j;
@@ -340,18 +335,16 @@ fn parallel(
         .reduce(|| WorstOverlap::NONE, WorstOverlap::max);
 
     // Pass 2: gather per particle in the serial order, then walls.
-    let pair_hist = &history.pair;
-    let wall_ends: Vec<usize> = chunk_bounds
-        .iter()
-        .map(|&hi| list.wall_start[hi] as usize)
-        .collect();
+    let pair_touching = &history.pair_touching;
+    let wall_ends: Vec<usize> = chunk_bounds.iter().map(|&hi| list.wall_start[hi] as usize).collect();
     let wall_hist_parts = split_by_offsets(&mut history.wall, &wall_ends);
+    let wall_touching_parts = split_by_offsets(&mut history.wall_touching, &wall_ends);
     let worst_walls = force
         .par_chunks_mut(CHUNK)
         .zip(torque.par_chunks_mut(CHUNK))
-        .zip(wall_hist_parts)
+        .zip(wall_hist_parts.into_par_iter().zip(wall_touching_parts))
         .enumerate()
-        .map(|(c, ((fc, tc), wall_hist))| {
+        .map(|(c, ((fc, tc), (wall_hist, wall_touching)))| {
             let lo = c * CHUNK;
             let wall_base = list.wall_start[lo] as usize;
             let mut worst = WorstOverlap::NONE;
@@ -362,13 +355,13 @@ fn parallel(
                 let rev = list.reverse_start[p] as usize..list.reverse_start[p + 1] as usize;
                 for &slot in &list.reverse_slot[rev] {
                     let slot = slot as usize;
-                    if pair_hist[slot].active {
+                    if pair_touching[slot] {
                         f -= buffers.force_on_i[slot];
                         t += buffers.torque_on_j[slot];
                     }
                 }
                 for k in list.pairs_of(p) {
-                    if pair_hist[k].active {
+                    if pair_touching[k] {
                         f += buffers.force_on_i[k];
                         t += buffers.torque_on_i[k];
                     }
@@ -378,6 +371,7 @@ fn parallel(
                 ctx.walls(
                     p,
                     &list.wall_partner[walls],
+                    &mut wall_touching[local.clone()],
                     &mut wall_hist[local],
                     &mut f,
                     &mut t,

@@ -1,9 +1,10 @@
 //! Velocity Verlet for translation and rotation of spheres, as LIGGGHTS/LAMMPS `nve/sphere` does it:
 //! half kick → drift → forces (with half-step velocities) → half kick.
 //!
-//! Each particle is updated independently, so the parallel loops are trivially deterministic. The kicks also detect
-//! non-finite values and the drift detects particles leaving the box; what failed is reported by the caller with
-//! the step and particle.
+//! The first half kick, the drift, the lost-particle check and the neighbour-list displacement check are one pass
+//! over the particles ([`kick_drift`]); the second half kick is another ([`kick`]). The integrator is memory-bound,
+//! so passes, not arithmetic, set its cost. Each particle is updated independently, so the parallel loops are
+//! trivially deterministic.
 
 use rayon::prelude::*;
 
@@ -13,65 +14,113 @@ use super::particles::Particles;
 
 const CHUNK: usize = 2048;
 
-/// v += ½dt (F/m + g), ω += ½dt T/I. Returns the index of the first particle whose new velocity or angular
-/// velocity is not finite, if any.
-pub fn half_kick(p: &mut Particles, gravity: &Vec3, dt_s: f64, pseudo_2d: bool) -> Option<usize> {
+/// What went wrong with a particle during a pass.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum BadParticle {
+    NonFinite(usize),
+    Lost(usize),
+}
+
+impl BadParticle {
+    fn index(self) -> usize {
+        match self {
+            BadParticle::NonFinite(i) | BadParticle::Lost(i) => i,
+        }
+    }
+}
+
+fn first(a: Option<BadParticle>, b: Option<BadParticle>) -> Option<BadParticle> {
+    match (a, b) {
+        (Some(x), Some(y)) => Some(if x.index() <= y.index() { x } else { y }),
+        (x, None) => x,
+        (None, y) => y,
+    }
+}
+
+/// A vector is finite when the sum of its components is (a NaN or infinity anywhere propagates).
+#[inline(always)]
+fn finite(v: &Vec3) -> bool {
+    (v.x + v.y + v.z).is_finite()
+}
+
+/// v += ½dt (F/m + g), ω += ½dt T/I for particle k (LIGGGHTS' dtf/m form: one division per particle).
+#[inline(always)]
+fn half_kick_one(v: &mut Vec3, w: &mut Vec3, f: &Vec3, t: &Vec3, m: f64, inertia: f64, g_half_dt: &Vec3, half_dt: f64) {
+    *v += f * (half_dt / m) + g_half_dt;
+    *w += t * (half_dt / inertia);
+}
+
+/// First half of a step: half kick, drift (wrapped on periodic axes), and checks. Returns the largest squared
+/// displacement from `reference` (the positions at the last neighbour-list build; empty = skip) and the first
+/// particle that became non-finite or left the box.
+#[allow(clippy::too_many_arguments)]
+pub fn kick_drift(
+    p: &mut Particles,
+    gravity: &Vec3,
+    dt_s: f64,
+    pseudo_2d: bool,
+    domain: &Domain,
+    lost_tolerance_m: f64,
+    reference: &[Vec3],
+) -> (f64, Option<BadParticle>) {
     let half_dt = 0.5 * dt_s;
-    let g = *gravity;
-    let bad = p
-        .velocity_m_per_s
+    let g_half_dt = gravity * half_dt;
+    let check_displacement = reference.len() == p.len();
+    p.position_m
         .par_chunks_mut(CHUNK)
+        .zip(p.velocity_m_per_s.par_chunks_mut(CHUNK))
         .zip(p.angular_velocity_rad_per_s.par_chunks_mut(CHUNK))
-        .zip(p.force_n.par_chunks(CHUNK))
-        .zip(p.torque_n_m.par_chunks(CHUNK))
-        .zip(
-            p.mass_kg
-                .par_chunks(CHUNK)
-                .zip(p.inertia_kg_m2.par_chunks(CHUNK)),
-        )
+        .zip(p.force_n.par_chunks(CHUNK).zip(p.torque_n_m.par_chunks(CHUNK)))
+        .zip(p.mass_kg.par_chunks(CHUNK).zip(p.inertia_kg_m2.par_chunks(CHUNK)))
         .enumerate()
-        .map(|(c, ((((v, w), f), t), (m, inertia)))| {
+        .map(|(c, ((((x, v), w), (f, t)), (m, inertia)))| {
             let mut bad = None;
-            for k in 0..v.len() {
-                v[k] += (f[k] / m[k] + g) * half_dt;
-                w[k] += t[k] * (half_dt / inertia[k]);
+            let mut max_d2 = 0.0f64;
+            for k in 0..x.len() {
+                half_kick_one(&mut v[k], &mut w[k], &f[k], &t[k], m[k], inertia[k], &g_half_dt, half_dt);
                 if pseudo_2d {
                     v[k].z = 0.0;
                     w[k].x = 0.0;
                     w[k].y = 0.0;
                 }
-                if bad.is_none()
-                    && !(v[k].iter().all(|x| x.is_finite()) && w[k].iter().all(|x| x.is_finite()))
-                {
-                    bad = Some(c * CHUNK + k);
-                }
-            }
-            bad
-        })
-        .reduce(|| None, |a, b| a.min(b).or(a).or(b));
-    bad
-}
-
-/// x += v dt, wrapped on periodic axes. Returns the first particle that is non-finite or outside the box.
-pub fn drift(
-    p: &mut Particles,
-    domain: &Domain,
-    dt_s: f64,
-    lost_tolerance_m: f64,
-) -> Option<usize> {
-    p.position_m
-        .par_chunks_mut(CHUNK)
-        .zip(p.velocity_m_per_s.par_chunks(CHUNK))
-        .enumerate()
-        .map(|(c, (x, v))| {
-            let mut bad = None;
-            for k in 0..x.len() {
                 x[k] += v[k] * dt_s;
                 domain.wrap(&mut x[k]);
-                if bad.is_none()
-                    && (!x[k].iter().all(|a| a.is_finite())
-                        || domain.is_lost(&x[k], lost_tolerance_m))
-                {
+                if check_displacement {
+                    max_d2 = max_d2.max(domain.separation(&x[k], &reference[c * CHUNK + k]).norm_squared());
+                }
+                if bad.is_none() {
+                    if !(finite(&x[k]) && finite(&v[k]) && finite(&w[k])) {
+                        bad = Some(BadParticle::NonFinite(c * CHUNK + k));
+                    } else if domain.is_lost(&x[k], lost_tolerance_m) {
+                        bad = Some(BadParticle::Lost(c * CHUNK + k));
+                    }
+                }
+            }
+            (max_d2, bad)
+        })
+        .reduce(|| (0.0, None), |a, b| (a.0.max(b.0), first(a.1, b.1)))
+}
+
+/// Second half kick. Returns the first particle whose velocity or angular velocity is not finite.
+pub fn kick(p: &mut Particles, gravity: &Vec3, dt_s: f64, pseudo_2d: bool) -> Option<usize> {
+    let half_dt = 0.5 * dt_s;
+    let g_half_dt = gravity * half_dt;
+    p.velocity_m_per_s
+        .par_chunks_mut(CHUNK)
+        .zip(p.angular_velocity_rad_per_s.par_chunks_mut(CHUNK))
+        .zip(p.force_n.par_chunks(CHUNK).zip(p.torque_n_m.par_chunks(CHUNK)))
+        .zip(p.mass_kg.par_chunks(CHUNK).zip(p.inertia_kg_m2.par_chunks(CHUNK)))
+        .enumerate()
+        .map(|(c, (((v, w), (f, t)), (m, inertia)))| {
+            let mut bad = None;
+            for k in 0..v.len() {
+                half_kick_one(&mut v[k], &mut w[k], &f[k], &t[k], m[k], inertia[k], &g_half_dt, half_dt);
+                if pseudo_2d {
+                    v[k].z = 0.0;
+                    w[k].x = 0.0;
+                    w[k].y = 0.0;
+                }
+                if bad.is_none() && !(finite(&v[k]) && finite(&w[k])) {
                     bad = Some(c * CHUNK + k);
                 }
             }

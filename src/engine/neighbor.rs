@@ -49,25 +49,19 @@ impl NeighborList {
         self.wall_start[i] as usize..self.wall_start[i + 1] as usize
     }
 
-    /// True when the list may miss a contact: some particle moved more than skin/2 since the build (two particles
-    /// closing on each other use up the skin), or a moving wall's surface moved more than skin/2.
-    pub fn needs_rebuild(
-        &self,
-        domain: &Domain,
-        position: &[Vec3],
-        walls: &[Wall],
-        wall_angle: &[f64],
-    ) -> bool {
-        if self.reference_position.len() != position.len() || self.builds == 0 {
+    /// Positions at the last build (empty before the first), for the integrator's displacement check.
+    pub fn reference_positions(&self) -> &[Vec3] {
+        &self.reference_position
+    }
+
+    /// True when the list may miss a contact: some particle moved more than skin/2 since the build
+    /// (`max_displacement2_m2` is the largest squared displacement; two particles closing on each other use up the
+    /// skin), a moving wall's surface moved more than skin/2, or the particle count changed.
+    pub fn needs_rebuild(&self, n_particles: usize, max_displacement2_m2: f64, walls: &[Wall], wall_angle: &[f64]) -> bool {
+        if self.reference_position.len() != n_particles || self.builds == 0 {
             return true;
         }
-        let limit2 = (0.5 * self.skin_m).powi(2);
-        let moved = position
-            .par_iter()
-            .zip(self.reference_position.par_iter())
-            .with_min_len(4096)
-            .any(|(x, x0)| domain.separation(x, x0).norm_squared() > limit2);
-        if moved {
+        if max_displacement2_m2 > (0.5 * self.skin_m).powi(2) {
             return true;
         }
         walls
@@ -164,9 +158,7 @@ impl NeighborList {
                     let xi = position[i];
                     let ri = radius[i];
                     for &cell in &neighbor_cells {
-                        for &j in
-                            &cell_particle[cell_start[cell] as usize..cell_start[cell + 1] as usize]
-                        {
+                        for &j in &cell_particle[cell_start[cell] as usize..cell_start[cell + 1] as usize] {
                             let j = j as usize;
                             if j <= i {
                                 continue;
@@ -270,9 +262,7 @@ mod tests {
             (state >> 11) as f64 / (1u64 << 53) as f64
         };
         let n = 400;
-        let position: Vec<Vec3> = (0..n)
-            .map(|_| Vec3::new(rnd(), 0.5 * rnd(), 0.3 * rnd()))
-            .collect();
+        let position: Vec<Vec3> = (0..n).map(|_| Vec3::new(rnd(), 0.5 * rnd(), 0.3 * rnd())).collect();
         let radius: Vec<f64> = (0..n).map(|_| 0.02 + 0.02 * rnd()).collect();
         let mut list = NeighborList::default();
         list.build(&domain, &position, &radius, 0.01, &[], &[]);
@@ -284,16 +274,11 @@ mod tests {
                     expected.push(j as u32);
                 }
             }
-            assert_eq!(
-                &list.partner[list.pairs_of(i)],
-                expected.as_slice(),
-                "particle {i}"
-            );
+            assert_eq!(&list.partner[list.pairs_of(i)], expected.as_slice(), "particle {i}");
         }
         // The transpose lists every slot once, grouped by partner, ascending in the first particle.
         for j in 0..n {
-            let slots = &list.reverse_slot
-                [list.reverse_start[j] as usize..list.reverse_start[j + 1] as usize];
+            let slots = &list.reverse_slot[list.reverse_start[j] as usize..list.reverse_start[j + 1] as usize];
             let mut last_i = None;
             for &s in slots {
                 assert_eq!(list.partner[s as usize] as usize, j);

@@ -118,13 +118,7 @@ impl Particles {
     }
 
     /// Appends a particle at rest made of `species`, with radius `radius_m`, and returns its id.
-    pub fn push(
-        &mut self,
-        species_id: SpeciesId,
-        species: &Species,
-        radius_m: f64,
-        position_m: Vec3,
-    ) -> ParticleId {
+    pub fn push(&mut self, species_id: SpeciesId, species: &Species, radius_m: f64, position_m: Vec3) -> ParticleId {
         let id = ParticleId(self.id.len() as u32);
         let mass = species.density_kg_per_m3 * 4.0 / 3.0 * std::f64::consts::PI * radius_m.powi(3);
         self.id.push(id);
@@ -170,8 +164,7 @@ impl Particles {
         let v3 = std::mem::size_of::<Vec3>();
         self.id.capacity() * 4
             + self.species.capacity() * 2
-            + (self.radius_m.capacity() + self.mass_kg.capacity() + self.inertia_kg_m2.capacity())
-                * 8
+            + (self.radius_m.capacity() + self.mass_kg.capacity() + self.inertia_kg_m2.capacity()) * 8
             + (self.position_m.capacity()
                 + self.velocity_m_per_s.capacity()
                 + self.angular_velocity_rad_per_s.capacity()

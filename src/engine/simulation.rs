@@ -11,7 +11,7 @@ use std::time::{Duration, Instant};
 use super::contacts::AlignedHistory;
 use super::forces::{PairBuffers, compute_contact_forces};
 use super::geometry::{Domain, Gravity, Wall};
-use super::integrate::{drift, half_kick};
+use super::integrate::{BadParticle, kick, kick_drift};
 use super::models::{ContactLaw, PairTable};
 use super::neighbor::NeighborList;
 use super::particles::{ParticleId, Particles, SpeciesTable};
@@ -83,7 +83,7 @@ impl Simulation {
             pool: make_pool(threads),
             timers: StageTimers::default(),
         };
-        sim.refresh_neighbors(true);
+        sim.refresh_neighbors();
         // The first half kick needs F(0). With dt = 0 the tangential springs do not move.
         let worst = sim.with_pool(|s| s.forces(0.0));
         sim.check_overlap(worst)?;
@@ -91,11 +91,7 @@ impl Simulation {
     }
 
     /// Resumes from a checkpointed state; the next `step()` continues exactly where the saved run was.
-    pub fn restore(
-        config: Arc<SimConfig>,
-        state: SimState,
-        threads: usize,
-    ) -> Result<Self, NumericalError> {
+    pub fn restore(config: Arc<SimConfig>, state: SimState, threads: usize) -> Result<Self, NumericalError> {
         let mut sim = Simulation {
             config,
             particles: state.particles,
@@ -150,8 +146,8 @@ impl Simulation {
     /// Number of active particle–particle and particle–wall contacts.
     pub fn contact_counts(&self) -> (usize, usize) {
         (
-            self.history.pair.iter().filter(|h| h.active).count(),
-            self.history.wall.iter().filter(|h| h.active).count(),
+            self.history.pair_touching.iter().filter(|&&t| t).count(),
+            self.history.wall_touching.iter().filter(|&&t| t).count(),
         )
     }
 
@@ -160,7 +156,7 @@ impl Simulation {
         let mut z = vec![0u32; self.particles.len()];
         for i in 0..self.particles.len() {
             for k in self.list.pairs_of(i) {
-                if self.history.pair[k].active {
+                if self.history.pair_touching[k] {
                     z[i] += 1;
                     z[self.list.partner[k] as usize] += 1;
                 }
@@ -171,10 +167,7 @@ impl Simulation {
 
     /// Approximate heap bytes of state and workspace.
     pub fn heap_bytes(&self) -> usize {
-        self.particles.heap_bytes()
-            + self.list.heap_bytes()
-            + self.history.heap_bytes()
-            + self.buffers.heap_bytes()
+        self.particles.heap_bytes() + self.list.heap_bytes() + self.history.heap_bytes() + self.buffers.heap_bytes()
     }
 
     /// Advances `n` steps.
@@ -195,25 +188,26 @@ impl Simulation {
         let config = Arc::clone(&self.config);
         let t0 = Instant::now();
         let g0 = config.gravity.at(self.time_s);
-        if let Some(i) = half_kick(&mut self.particles, &g0, dt, config.pseudo_2d) {
-            return Err(self.non_finite(i));
-        }
         let lost_tolerance = self.particles.max_radius_m();
-        if let Some(i) = drift(&mut self.particles, &config.domain, dt, lost_tolerance) {
-            let x = self.particles.position_m[i];
-            return Err(if x.iter().all(|a| a.is_finite()) {
-                NumericalError::ParticleLost {
+        let (max_displacement2, bad) = kick_drift(
+            &mut self.particles,
+            &g0,
+            dt,
+            config.pseudo_2d,
+            &config.domain,
+            lost_tolerance,
+            self.list.reference_positions(),
+        );
+        match bad {
+            Some(BadParticle::NonFinite(i)) => return Err(self.non_finite(i)),
+            Some(BadParticle::Lost(i)) => {
+                return Err(NumericalError::ParticleLost {
                     step: self.step + 1,
                     particle: ParticleId(i as u32),
-                    position_m: x,
-                }
-            } else {
-                NumericalError::NonFinite {
-                    step: self.step + 1,
-                    particle: ParticleId(i as u32),
-                    field: "position",
-                }
-            });
+                    position_m: self.particles.position_m[i],
+                });
+            }
+            None => {}
         }
         for (angle, wall) in self.wall_angle_rad.iter_mut().zip(&config.walls) {
             *angle += wall.angular_velocity_rad_per_s() * dt;
@@ -221,12 +215,14 @@ impl Simulation {
         self.step += 1;
         self.time_s += dt;
         let t1 = Instant::now();
-        self.refresh_neighbors(false);
+        if self.list.needs_rebuild(self.particles.len(), max_displacement2, &config.walls, &self.wall_angle_rad) {
+            self.refresh_neighbors();
+        }
         let t2 = Instant::now();
         let worst = self.forces(dt);
         let t3 = Instant::now();
         let g1 = config.gravity.at(self.time_s);
-        if let Some(i) = half_kick(&mut self.particles, &g1, dt, config.pseudo_2d) {
+        if let Some(i) = kick(&mut self.particles, &g1, dt, config.pseudo_2d) {
             return Err(self.non_finite(i));
         }
         let t4 = Instant::now();
@@ -282,18 +278,8 @@ impl Simulation {
         )
     }
 
-    fn refresh_neighbors(&mut self, force: bool) {
+    fn refresh_neighbors(&mut self) {
         let c = &self.config;
-        if !force
-            && !self.list.needs_rebuild(
-                &c.domain,
-                &self.particles.position_m,
-                &c.walls,
-                &self.wall_angle_rad,
-            )
-        {
-            return;
-        }
         let store = self.history.to_store(&self.list);
         self.list.build(
             &c.domain,
@@ -320,13 +306,8 @@ impl Simulation {
         use super::models::NormalModel;
         let c = &self.config;
         let p = &self.particles;
-        let potential = |mat: &super::models::PairMaterial, r_star: f64, overlap: f64| match c
-            .contact_law
-            .normal
-        {
-            NormalModel::LinearSpringDashpot {
-                stiffness_n_per_m, ..
-            } => 0.5 * stiffness_n_per_m * overlap * overlap,
+        let potential = |mat: &super::models::PairMaterial, r_star: f64, overlap: f64| match c.contact_law.normal {
+            NormalModel::LinearSpringDashpot { stiffness_n_per_m, .. } => 0.5 * stiffness_n_per_m * overlap * overlap,
             NormalModel::Hertz { .. } | NormalModel::Thornton { .. } => {
                 8.0 / 15.0 * mat.effective_youngs_modulus_pa * r_star.sqrt() * overlap.powf(2.5)
             }
@@ -335,33 +316,19 @@ impl Simulation {
         for i in 0..p.len() {
             for k in self.list.pairs_of(i) {
                 let j = self.list.partner[k] as usize;
-                let d = c
-                    .domain
-                    .separation(&p.position_m[i], &p.position_m[j])
-                    .norm();
+                let d = c.domain.separation(&p.position_m[i], &p.position_m[j]).norm();
                 let overlap = p.radius_m[i] + p.radius_m[j] - d;
                 if overlap > 0.0 {
                     let r_star = p.radius_m[i] * p.radius_m[j] / (p.radius_m[i] + p.radius_m[j]);
-                    e += potential(
-                        c.pair_table.get(p.species[i], p.species[j]),
-                        r_star,
-                        overlap,
-                    );
+                    e += potential(c.pair_table.get(p.species[i], p.species[j]), r_star, overlap);
                 }
             }
             for k in self.list.walls_of(i) {
                 let w = self.list.wall_partner[k] as usize;
                 let wall = &c.walls[w];
-                let overlap = p.radius_m[i]
-                    - wall
-                        .proximity(&p.position_m[i], self.wall_angle_rad[w])
-                        .gap_m;
+                let overlap = p.radius_m[i] - wall.proximity(&p.position_m[i], self.wall_angle_rad[w]).gap_m;
                 if overlap > 0.0 {
-                    e += potential(
-                        c.pair_table.get(p.species[i], wall.species),
-                        p.radius_m[i],
-                        overlap,
-                    );
+                    e += potential(c.pair_table.get(p.species[i], wall.species), p.radius_m[i], overlap);
                 }
             }
         }
@@ -372,20 +339,14 @@ impl Simulation {
     pub fn mechanical_energy_j(&self) -> (f64, f64) {
         let g = self.config.gravity.at(self.time_s);
         let p = &self.particles;
-        let potential: f64 = (0..p.len())
-            .map(|i| -p.mass_kg[i] * g.dot(&p.position_m[i]))
-            .sum();
+        let potential: f64 = (0..p.len()).map(|i| -p.mass_kg[i] * g.dot(&p.position_m[i])).sum();
         (p.kinetic_energy_j(), potential)
     }
 
     /// Height of the bed along −g: the highest particle top, and the mean centre height, in m.
     pub fn bed_height_m(&self) -> (f64, f64) {
         let g = self.config.gravity.at(self.time_s);
-        let up = if g.norm() > 0.0 {
-            -g.normalize()
-        } else {
-            Vec3::z()
-        };
+        let up = if g.norm() > 0.0 { -g.normalize() } else { Vec3::z() };
         let p = &self.particles;
         let mut top = f64::NEG_INFINITY;
         let mut sum = 0.0;

@@ -112,13 +112,7 @@ pub fn first_difference(a: &SimState, b: &SimState) -> Option<String> {
                     &y.increment_direction,
                 )
             })
-            .or_else(|| {
-                f(
-                    &format!("{name}.max_overlap_m"),
-                    x.max_overlap_m,
-                    y.max_overlap_m,
-                )
-            })
+            .or_else(|| f(&format!("{name}.max_overlap_m"), x.max_overlap_m, y.max_overlap_m))
             .or_else(|| {
                 f(
                     &format!("{name}.max_normal_force_n"),
@@ -155,21 +149,9 @@ pub fn first_difference(a: &SimState, b: &SimState) -> Option<String> {
         .or_else(|| f("dt_s", a.dt_s, b.dt_s))
         .or_else(|| scalars("particles.radius_m", &p.radius_m, &q.radius_m))
         .or_else(|| scalars("particles.mass_kg", &p.mass_kg, &q.mass_kg))
-        .or_else(|| {
-            scalars(
-                "particles.inertia_kg_m2",
-                &p.inertia_kg_m2,
-                &q.inertia_kg_m2,
-            )
-        })
+        .or_else(|| scalars("particles.inertia_kg_m2", &p.inertia_kg_m2, &q.inertia_kg_m2))
         .or_else(|| vectors("particles.position_m", &p.position_m, &q.position_m))
-        .or_else(|| {
-            vectors(
-                "particles.velocity_m_per_s",
-                &p.velocity_m_per_s,
-                &q.velocity_m_per_s,
-            )
-        })
+        .or_else(|| vectors("particles.velocity_m_per_s", &p.velocity_m_per_s, &q.velocity_m_per_s))
         .or_else(|| {
             vectors(
                 "particles.angular_velocity_rad_per_s",
@@ -193,11 +175,7 @@ pub fn first_difference(a: &SimState, b: &SimState) -> Option<String> {
                             x.0.0, x.1.0, y.0.0, y.1.0
                         ));
                     }
-                    history(
-                        &format!("contacts.pairs[{k}] ({}, {})", x.0.0, x.1.0),
-                        &x.2,
-                        &y.2,
-                    )
+                    history(&format!("contacts.pairs[{k}] ({}, {})", x.0.0, x.1.0), &x.2, &y.2)
                 })
         })
         .or_else(|| {
@@ -213,11 +191,7 @@ pub fn first_difference(a: &SimState, b: &SimState) -> Option<String> {
                             x.0.0, x.1.0, y.0.0, y.1.0
                         ));
                     }
-                    history(
-                        &format!("contacts.walls[{k}] ({}, wall {})", x.0.0, x.1.0),
-                        &x.2,
-                        &y.2,
-                    )
+                    history(&format!("contacts.walls[{k}] ({}, wall {})", x.0.0, x.1.0), &x.2, &y.2)
                 })
         })
 }

@@ -75,18 +75,10 @@ impl Checker<'_> {
         Ok(u.normalize())
     }
 
-    fn species(
-        &self,
-        key: &str,
-        table: &SpeciesTable,
-        name: &str,
-    ) -> Result<SpeciesId, ConfigError> {
+    fn species(&self, key: &str, table: &SpeciesTable, name: &str) -> Result<SpeciesId, ConfigError> {
         table.find(name).ok_or_else(|| {
             let known: Vec<&str> = table.species.iter().map(|s| s.name.as_str()).collect();
-            self.fail(
-                key,
-                format!("unknown species '{name}'; defined: {}", known.join(", ")),
-            )
+            self.fail(key, format!("unknown species '{name}'; defined: {}", known.join(", ")))
         })
     }
 }
@@ -110,18 +102,12 @@ pub fn build(spec: ScenarioSpec, path: &Path) -> Result<BuiltScenario, ConfigErr
             ));
         }
         c.non_negative(&key("friction_coefficient"), s.friction_coefficient)?;
-        c.non_negative(
-            &key("rolling_friction_coefficient"),
-            s.rolling_friction_coefficient,
-        )?;
+        c.non_negative(&key("rolling_friction_coefficient"), s.rolling_friction_coefficient)?;
         if let Some(fy) = s.yield_force_n {
             c.positive(&key("yield_force_n"), fy)?;
         }
         if spec.species[..k].iter().any(|o| o.name == s.name) {
-            return Err(c.fail(
-                key("name"),
-                format!("species name '{}' is used twice", s.name),
-            ));
+            return Err(c.fail(key("name"), format!("species name '{}' is used twice", s.name)));
         }
     }
     let species = SpeciesTable {
@@ -143,11 +129,11 @@ pub fn build(spec: ScenarioSpec, path: &Path) -> Result<BuiltScenario, ConfigErr
             ));
         }
     }
-    let domain = Domain {
-        lo_m: Vec3::from(spec.domain.lo_m),
-        hi_m: Vec3::from(spec.domain.hi_m),
-        periodic: spec.domain.periodic,
-    };
+    let domain = Domain::new(
+        Vec3::from(spec.domain.lo_m),
+        Vec3::from(spec.domain.hi_m),
+        spec.domain.periodic,
+    );
     c.finite3("gravity.vector_m_per_s2", &spec.gravity.vector_m_per_s2)?;
     if let Some(flip) = spec.gravity.flip {
         c.positive("gravity.flip.frequency_hz", flip.frequency_hz)?;
@@ -157,20 +143,11 @@ pub fn build(spec: ScenarioSpec, path: &Path) -> Result<BuiltScenario, ConfigErr
     let mut rng = RngState::from_seed_u64(spec.seed).restore();
     let particles = fill(&c, &spec, &species, &domain, &walls, &mut rng)?;
 
-    let skin_m = spec
-        .neighbor
-        .skin_m
-        .unwrap_or(0.4 * particles.max_radius_m());
+    let skin_m = spec.neighbor.skin_m.unwrap_or(0.4 * particles.max_radius_m());
     c.positive("neighbor.skin_m", skin_m)?;
     c.positive("time.end_time_s", spec.time.end_time_s)?;
-    c.positive(
-        "time.reference_velocity_m_per_s",
-        spec.time.reference_velocity_m_per_s,
-    )?;
-    if !(spec.max_overlap_fraction.is_finite()
-        && spec.max_overlap_fraction > 0.0
-        && spec.max_overlap_fraction <= 1.0)
-    {
+    c.positive("time.reference_velocity_m_per_s", spec.time.reference_velocity_m_per_s)?;
+    if !(spec.max_overlap_fraction.is_finite() && spec.max_overlap_fraction > 0.0 && spec.max_overlap_fraction <= 1.0) {
         return Err(c.fail(
             "max_overlap_fraction",
             format!("expected 0 < value <= 1, got {}", spec.max_overlap_fraction),
@@ -205,7 +182,9 @@ pub fn build(spec: ScenarioSpec, path: &Path) -> Result<BuiltScenario, ConfigErr
     if !contact_time_s.is_finite() || contact_time_s <= 0.0 {
         return Err(c.fail(
             "contact.normal",
-            format!("the contact parameters give no finite contact duration ({contact_time_s} s): the dashpot is overdamped"),
+            format!(
+                "the contact parameters give no finite contact duration ({contact_time_s} s): the dashpot is overdamped"
+            ),
         ));
     }
     let dt_s = match (spec.time.dt_s, spec.time.dt_fraction_of_contact_time) {
@@ -223,10 +202,7 @@ pub fn build(spec: ScenarioSpec, path: &Path) -> Result<BuiltScenario, ConfigErr
             fraction * contact_time_s
         }
         _ => {
-            return Err(c.fail(
-                "time",
-                "give exactly one of dt_s and dt_fraction_of_contact_time",
-            ));
+            return Err(c.fail("time", "give exactly one of dt_s and dt_fraction_of_contact_time"));
         }
     };
 
@@ -324,17 +300,13 @@ fn build_walls(
                         continue;
                     }
                     let axis_name = ["x", "y", "z"][axis];
-                    for (side, point, sign) in [("lo", domain.lo_m, 1.0), ("hi", domain.hi_m, -1.0)]
-                    {
+                    for (side, point, sign) in [("lo", domain.lo_m, 1.0), ("hi", domain.hi_m, -1.0)] {
                         let mut normal = Vec3::zeros();
                         normal[axis] = sign;
                         walls.push(Wall {
                             name: format!("box_{axis_name}_{side}"),
                             species: id,
-                            shape: WallShape::Plane {
-                                point_m: point,
-                                normal,
-                            },
+                            shape: WallShape::Plane { point_m: point, normal },
                         });
                     }
                 }
@@ -398,10 +370,7 @@ fn build_walls(
         }
     }
     if walls.len() > u16::MAX as usize {
-        return Err(c.fail(
-            "walls",
-            format!("at most {} walls, got {}", u16::MAX, walls.len()),
-        ));
+        return Err(c.fail("walls", format!("at most {} walls, got {}", u16::MAX, walls.len())));
     }
     Ok(walls)
 }
@@ -435,10 +404,7 @@ fn baffle_segments(
                 ));
             }
             if !(tilt_deg.is_finite() && tilt_deg.abs() < 80.0) {
-                return Err(c.fail(
-                    key("tilt_deg"),
-                    format!("expected |tilt| < 80°, got {tilt_deg}"),
-                ));
+                return Err(c.fail(key("tilt_deg"), format!("expected |tilt| < 80°, got {tilt_deg}")));
             }
             let tilt = tilt_deg.to_radians();
             for k in 0..count as usize {
@@ -484,10 +450,7 @@ fn baffle_segments(
                     let phi = 2.0 * PI * k as f64 / count as f64;
                     let (s, co) = phi.sin_cos();
                     let a = [inner_radius_m * co, inner_radius_m * s];
-                    let b = [
-                        (inner_radius_m + length_m) * co,
-                        (inner_radius_m + length_m) * s,
-                    ];
+                    let b = [(inner_radius_m + length_m) * co, (inner_radius_m + length_m) * s];
                     out.push((k, (a, b), half_thickness_m));
                 }
             }
@@ -513,12 +476,7 @@ fn fits(x: &Vec3, r: f64, walls: &[Wall], domain: &Domain) -> bool {
         && walls.iter().all(|w| w.proximity(x, 0.0).gap_m >= r)
 }
 
-fn drum_named<'a>(
-    c: &Checker,
-    key: &str,
-    walls: &'a [Wall],
-    name: &str,
-) -> Result<&'a Wall, ConfigError> {
+fn drum_named<'a>(c: &Checker, key: &str, walls: &'a [Wall], name: &str) -> Result<&'a Wall, ConfigError> {
     walls
         .iter()
         .find(|w| w.name == name && matches!(w.shape, WallShape::RotatingCylinder { .. }))
@@ -557,7 +515,10 @@ fn fill(
                 if *spacing_m < 2.0 * sp.radius_m {
                     return Err(c.fail(
                         key("spacing_m"),
-                        format!("lattice spacing {spacing_m} m is smaller than the particle diameter {} m", 2.0 * sp.radius_m),
+                        format!(
+                            "lattice spacing {spacing_m} m is smaller than the particle diameter {} m",
+                            2.0 * sp.radius_m
+                        ),
                     ));
                 }
                 if let Some(d) = inside_drum {
@@ -679,17 +640,7 @@ fn fill(
                         ),
                     ));
                 }
-                let placed = random_insert(
-                    &mut particles,
-                    id,
-                    sp,
-                    *count as usize,
-                    lo_m,
-                    hi_m,
-                    walls,
-                    domain,
-                    rng,
-                );
+                let placed = random_insert(&mut particles, id, sp, *count as usize, lo_m, hi_m, walls, domain, rng);
                 if placed < *count as usize {
                     return Err(c.fail(
                         key("count"),
@@ -722,9 +673,7 @@ fn random_insert(
     // Lookup only (never iterated), so the map's order cannot leak into results; BTreeMap keeps it obviously so.
     let mut grid: BTreeMap<[i64; 3], Vec<usize>> = BTreeMap::new();
     for i in 0..particles.len() {
-        grid.entry(key(&particles.position_m[i]))
-            .or_default()
-            .push(i);
+        grid.entry(key(&particles.position_m[i])).or_default().push(i);
     }
     let mut placed = 0;
     let max_attempts = 1000 * count;
@@ -745,10 +694,7 @@ fn random_insert(
             // The grid does not wrap; periodic images are checked by brute force (fills are built once).
             clear = (0..particles.len()).all(|j| {
                 let reach = r + particles.radius_m[j];
-                domain
-                    .separation(&x, &particles.position_m[j])
-                    .norm_squared()
-                    >= reach * reach
+                domain.separation(&x, &particles.position_m[j]).norm_squared() >= reach * reach
             });
         } else {
             'search: for dz in -1..=1 {
@@ -757,11 +703,7 @@ fn random_insert(
                         if let Some(list) = grid.get(&[k[0] + dx, k[1] + dy, k[2] + dz]) {
                             for &j in list {
                                 let reach = r + particles.radius_m[j];
-                                if domain
-                                    .separation(&x, &particles.position_m[j])
-                                    .norm_squared()
-                                    < reach * reach
-                                {
+                                if domain.separation(&x, &particles.position_m[j]).norm_squared() < reach * reach {
                                     clear = false;
                                     break 'search;
                                 }

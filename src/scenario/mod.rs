@@ -38,17 +38,15 @@ pub fn parse(text: &str, path: &Path) -> Result<ScenarioSpec, ConfigError> {
     // Enums are written as single-key maps (`normal: { hertz: { restitution: 0.9 } }`), the form the model names
     // take everywhere else, rather than serde_norway's default YAML tags (`!hertz`).
     let de = serde_norway::Deserializer::from_str(text);
-    serde_norway::with::singleton_map_recursive::deserialize(de).map_err(
-        |e: serde_norway::Error| {
-            let (line, column) = e.location().map_or((0, 0), |l| (l.line(), l.column()));
-            ConfigError::Yaml {
-                path: path.to_path_buf(),
-                line,
-                column,
-                message: e.to_string(),
-            }
-        },
-    )
+    serde_norway::with::singleton_map_recursive::deserialize(de).map_err(|e: serde_norway::Error| {
+        let (line, column) = e.location().map_or((0, 0), |l| (l.line(), l.column()));
+        ConfigError::Yaml {
+            path: path.to_path_buf(),
+            line,
+            column,
+            message: e.to_string(),
+        }
+    })
 }
 
 /// Reads, parses and validates a scenario file.

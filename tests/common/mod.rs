@@ -9,19 +9,11 @@ use granflow::scenario::{self, BuiltScenario};
 
 pub fn built(yaml: &str) -> BuiltScenario {
     let path = Path::new("test-scenario.yaml");
-    scenario::build(scenario::parse(yaml, path).expect("test YAML parses"), path)
-        .expect("test scenario is valid")
+    scenario::build(scenario::parse(yaml, path).expect("test YAML parses"), path).expect("test scenario is valid")
 }
 
 pub fn simulation(b: &BuiltScenario, threads: usize) -> Simulation {
-    Simulation::new(
-        b.config.clone(),
-        b.particles.clone(),
-        b.dt_s,
-        b.rng,
-        threads,
-    )
-    .expect("initial state is sound")
+    Simulation::new(b.config.clone(), b.particles.clone(), b.dt_s, b.rng, threads).expect("initial state is sound")
 }
 
 /// Runs the granflow binary built for this test run.

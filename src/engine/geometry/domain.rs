@@ -12,9 +12,20 @@ pub struct Domain {
     pub lo_m: Vec3,
     pub hi_m: Vec3,
     pub periodic: [bool; 3],
+    /// Any axis periodic: when false, the separation is a plain difference (the hot loop's fast path).
+    any_periodic: bool,
 }
 
 impl Domain {
+    pub fn new(lo_m: Vec3, hi_m: Vec3, periodic: [bool; 3]) -> Self {
+        Domain {
+            lo_m,
+            hi_m,
+            periodic,
+            any_periodic: periodic.iter().any(|&p| p),
+        }
+    }
+
     pub fn length_m(&self) -> Vec3 {
         self.hi_m - self.lo_m
     }
@@ -23,6 +34,9 @@ impl Domain {
     #[inline]
     pub fn separation(&self, a: &Vec3, b: &Vec3) -> Vec3 {
         let mut d = a - b;
+        if !self.any_periodic {
+            return d;
+        }
         for axis in 0..3 {
             if self.periodic[axis] {
                 let l = self.hi_m[axis] - self.lo_m[axis];
@@ -39,6 +53,9 @@ impl Domain {
     /// Wraps a position into the box on periodic axes.
     #[inline]
     pub fn wrap(&self, x: &mut Vec3) {
+        if !self.any_periodic {
+            return;
+        }
         for axis in 0..3 {
             if self.periodic[axis] {
                 let l = self.hi_m[axis] - self.lo_m[axis];
@@ -55,9 +72,7 @@ impl Domain {
     #[inline]
     pub fn is_lost(&self, x: &Vec3, tolerance_m: f64) -> bool {
         (0..3).any(|axis| {
-            !self.periodic[axis]
-                && (x[axis] < self.lo_m[axis] - tolerance_m
-                    || x[axis] > self.hi_m[axis] + tolerance_m)
+            !self.periodic[axis] && (x[axis] < self.lo_m[axis] - tolerance_m || x[axis] > self.hi_m[axis] + tolerance_m)
         })
     }
 }

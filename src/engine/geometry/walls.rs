@@ -22,11 +22,7 @@ pub struct RotatingFrame {
 impl RotatingFrame {
     pub fn new(axis_point_m: Vec3, axis: Vec3, angular_velocity_rad_per_s: f64) -> Self {
         let axis = axis.normalize();
-        let reference = if axis.x.abs() < 0.9 {
-            Vec3::x()
-        } else {
-            Vec3::y()
-        };
+        let reference = if axis.x.abs() < 0.9 { Vec3::x() } else { Vec3::y() };
         let e1 = (reference - axis * axis.dot(&reference)).normalize();
         let e2 = axis.cross(&e1);
         RotatingFrame {
@@ -141,8 +137,7 @@ impl Wall {
                 let radial = r - frame.axis * r.dot(&frame.axis);
                 let rho = radial.norm();
                 let outward = if rho > 0.0 { radial / rho } else { frame.e1 };
-                let contact_point =
-                    frame.axis_point_m + frame.axis * r.dot(&frame.axis) + outward * *radius_m;
+                let contact_point = frame.axis_point_m + frame.axis * r.dot(&frame.axis) + outward * *radius_m;
                 WallProximity {
                     gap_m: radius_m - rho,
                     normal: -outward,
@@ -193,10 +188,7 @@ mod tests {
         let wall = Wall {
             name: "drum".into(),
             species: SpeciesId(0),
-            shape: WallShape::RotatingCylinder {
-                frame,
-                radius_m: 1.0,
-            },
+            shape: WallShape::RotatingCylinder { frame, radius_m: 1.0 },
         };
         let p = wall.proximity(&Vec3::new(0.0, -0.9, 0.3), 0.0);
         assert!((p.gap_m - 0.1).abs() < 1e-12);

@@ -50,11 +50,7 @@ pub struct ContactOutput {
 impl ContactLaw {
     /// Names of the slot models, as stored in checkpoints and results.
     pub fn model_names(&self) -> [&'static str; 3] {
-        [
-            self.normal.name(),
-            self.tangential.name(),
-            self.rolling.name(),
-        ]
+        [self.normal.name(), self.tangential.name(), self.rolling.name()]
     }
 
     /// Evaluates one overlapping contact and updates its history.
@@ -68,25 +64,13 @@ impl ContactLaw {
     ) -> ContactOutput {
         let n = k.normal;
         let vn = k.contact_velocity.dot(&n);
-        let normal = self.normal.force(
-            mat,
-            k.effective_radius_m,
-            k.effective_mass_kg,
-            k.overlap_m,
-            vn,
-            hist,
-        );
+        let normal = self
+            .normal
+            .force(mat, k.effective_radius_m, k.effective_mass_kg, k.overlap_m, vn, hist);
         let vt = k.contact_velocity - n * vn;
-        let ft = self.tangential.force(
-            &self.normal,
-            mat,
-            k.effective_mass_kg,
-            &normal,
-            &n,
-            &vt,
-            dt_s,
-            hist,
-        );
+        let ft = self
+            .tangential
+            .force(&self.normal, mat, k.effective_mass_kg, &normal, &n, &vt, dt_s, hist);
         let rolling_torque = self.rolling.torque(
             mat.rolling_friction_coefficient,
             k.effective_radius_m,

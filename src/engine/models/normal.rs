@@ -86,10 +86,7 @@ impl NormalModel {
                 let e_star = mat.effective_youngs_modulus_pa;
                 let kn = 4.0 / 3.0 * e_star * contact_radius;
                 let sn = 2.0 * e_star * contact_radius;
-                let gamma_n = 2.0
-                    * SQRT_FIVE_SIXTHS
-                    * damping_beta(restitution)
-                    * (sn * effective_mass_kg).sqrt();
+                let gamma_n = 2.0 * SQRT_FIVE_SIXTHS * damping_beta(restitution) * (sn * effective_mass_kg).sqrt();
                 NormalOutput {
                     force_n: kn * overlap_m - gamma_n * normal_velocity_m_per_s,
                     contact_radius_m: contact_radius,
@@ -130,9 +127,7 @@ impl NormalModel {
             }
             NormalModel::Hertz { .. } | NormalModel::Thornton { .. } => {
                 let e = mat.effective_youngs_modulus_pa;
-                2.87 * (effective_mass_kg.powi(2)
-                    / (effective_radius_m * e * e * impact_velocity_m_per_s))
-                    .powf(0.2)
+                2.87 * (effective_mass_kg.powi(2) / (effective_radius_m * e * e * impact_velocity_m_per_s)).powf(0.2)
             }
         }
     }
@@ -186,8 +181,7 @@ pub fn thornton_force(
         kn * overlap_m * overlap_m.sqrt()
     } else {
         let f_max = hist.max_normal_force_n;
-        let r_bar = (yield_force_n / f_max)
-            * ((2.0 * f_max + yield_force_n) / (3.0 * yield_force_n)).powf(1.5);
+        let r_bar = (yield_force_n / f_max) * ((2.0 * f_max + yield_force_n) / (3.0 * yield_force_n)).powf(1.5);
         let k_unload = kn * r_bar.sqrt();
         let plastic_overlap = hist.max_overlap_m - (f_max / k_unload).powf(2.0 / 3.0);
         let elastic = overlap_m - plastic_overlap;

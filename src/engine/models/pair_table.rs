@@ -35,8 +35,7 @@ impl PairTable {
             for b in &species.species {
                 let inv_e = (1.0 - a.poisson_ratio.powi(2)) / a.youngs_modulus_pa
                     + (1.0 - b.poisson_ratio.powi(2)) / b.youngs_modulus_pa;
-                let inv_g = 2.0 * (2.0 - a.poisson_ratio) * (1.0 + a.poisson_ratio)
-                    / a.youngs_modulus_pa
+                let inv_g = 2.0 * (2.0 - a.poisson_ratio) * (1.0 + a.poisson_ratio) / a.youngs_modulus_pa
                     + 2.0 * (2.0 - b.poisson_ratio) * (1.0 + b.poisson_ratio) / b.youngs_modulus_pa;
                 // CHOICE: the seeds use one material per simulation and never say how μ, μ_r or F_y combine
                 // between unlike species. We take the arithmetic mean of μ and μ_r (symmetric and equal to the

@@ -198,9 +198,7 @@ mod tests {
             force_n: 2.0,
             contact_radius_m: 1e-5,
         };
-        let model = TangentialModel::WaltonBraun {
-            exponent: 1.0 / 3.0,
-        };
+        let model = TangentialModel::WaltonBraun { exponent: 1.0 / 3.0 };
         let mut h = ContactHistory::default();
         let v = Vec3::new(-0.1, 0.0, 0.0); // pushes F_t towards +x
         let mut f = Vec3::zeros();
