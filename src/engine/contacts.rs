@@ -7,6 +7,7 @@
 //! ([`ContactStore`]), and a restored simulation merges that store into its first list. Both paths use the same
 //! merge, so a restart cannot lose or reorder a contact.
 
+use super::Vec3;
 use super::models::ContactHistory;
 use super::neighbor::NeighborList;
 use super::particles::ParticleId;
@@ -31,15 +32,206 @@ pub struct ContactStore {
     pub walls: Vec<(ParticleId, WallId, ContactHistory)>,
 }
 
-/// Histories aligned with a [`NeighborList`]: `pair[k]` belongs to slot k of `partner`, `wall[k]` to slot k of
-/// `wall_partner`. `pair_touching[k]` mirrors `pair[k].active` in a dense array: the force loop examines every
-/// candidate each step but touches the (large) history only for contacts, which keeps it out of cache otherwise.
+/// Which history fields a contact law needs; storage holds only those columns.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct HistoryLayout {
+    /// `tangential` (every tangential model).
+    pub tangential: bool,
+    /// `reversal_force_n`, `increment_direction` (Walton-Braun).
+    pub walton_braun: bool,
+    /// `max_overlap_m`, `max_normal_force_n`, `yielded` (Thornton).
+    pub thornton: bool,
+}
+
+/// Thornton's per-contact state, one column.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct ThorntonState {
+    pub max_overlap_m: f64,
+    pub max_normal_force_n: f64,
+    pub yielded: bool,
+}
+
+/// Contact histories as columns aligned with neighbour-list slots. `touching[k]` says whether slot k is an active
+/// contact; the other columns exist only when the layout asks for them (Hertz-Mindlin keeps 25 bytes per slot
+/// instead of a 100-byte struct), because the force loop streams through them every step.
+#[derive(Debug, Clone, Default)]
+pub struct HistoryColumns {
+    layout: HistoryLayout,
+    pub touching: Vec<bool>,
+    tangential: Vec<Vec3>,
+    reversal: Vec<Vec3>,
+    direction: Vec<Vec3>,
+    thornton: Vec<ThorntonState>,
+}
+
+/// Mutable view of a range of [`HistoryColumns`] (the parallel force loop works on disjoint views).
+pub struct ColumnsMut<'a> {
+    layout: HistoryLayout,
+    pub touching: &'a mut [bool],
+    tangential: &'a mut [Vec3],
+    reversal: &'a mut [Vec3],
+    direction: &'a mut [Vec3],
+    thornton: &'a mut [ThorntonState],
+}
+
+fn column<T: Clone + Default>(present: bool, len: usize) -> Vec<T> {
+    if present { vec![T::default(); len] } else { Vec::new() }
+}
+
+/// Splits `data` (which is either empty or as long as the last end) into pieces ending at `ends`.
+fn split_column<'a, T>(mut data: &'a mut [T], ends: &[usize]) -> Vec<&'a mut [T]> {
+    if data.is_empty() {
+        return ends.iter().map(|_| <&mut [T]>::default()).collect();
+    }
+    let mut out = Vec::with_capacity(ends.len());
+    let mut consumed = 0;
+    for &end in ends {
+        let (head, tail) = data.split_at_mut(end - consumed);
+        out.push(head);
+        data = tail;
+        consumed = end;
+    }
+    out
+}
+
+impl HistoryColumns {
+    pub fn new(len: usize, layout: HistoryLayout) -> Self {
+        HistoryColumns {
+            layout,
+            touching: vec![false; len],
+            tangential: column(layout.tangential, len),
+            reversal: column(layout.walton_braun, len),
+            direction: column(layout.walton_braun, len),
+            thornton: column(layout.thornton, len),
+        }
+    }
+
+    pub fn len(&self) -> usize {
+        self.touching.len()
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.touching.is_empty()
+    }
+
+    pub fn view(&mut self) -> ColumnsMut<'_> {
+        ColumnsMut {
+            layout: self.layout,
+            touching: &mut self.touching,
+            tangential: &mut self.tangential,
+            reversal: &mut self.reversal,
+            direction: &mut self.direction,
+            thornton: &mut self.thornton,
+        }
+    }
+
+    /// Disjoint views ending at the given slot offsets.
+    pub fn split(&mut self, ends: &[usize]) -> Vec<ColumnsMut<'_>> {
+        let layout = self.layout;
+        let mut touching = split_column(&mut self.touching, ends).into_iter();
+        let mut tangential = split_column(&mut self.tangential, ends).into_iter();
+        let mut reversal = split_column(&mut self.reversal, ends).into_iter();
+        let mut direction = split_column(&mut self.direction, ends).into_iter();
+        let mut thornton = split_column(&mut self.thornton, ends).into_iter();
+        ends.iter()
+            .map(|_| ColumnsMut {
+                layout,
+                touching: touching.next().expect("one piece per end"),
+                tangential: tangential.next().expect("one piece per end"),
+                reversal: reversal.next().expect("one piece per end"),
+                direction: direction.next().expect("one piece per end"),
+                thornton: thornton.next().expect("one piece per end"),
+            })
+            .collect()
+    }
+
+    /// The full history of slot k (zero fields for columns the layout does not keep).
+    pub fn get(&self, k: usize) -> ContactHistory {
+        let mut h = ContactHistory {
+            active: self.touching[k],
+            ..ContactHistory::INACTIVE
+        };
+        if self.layout.tangential {
+            h.tangential = self.tangential[k];
+        }
+        if self.layout.walton_braun {
+            h.reversal_force_n = self.reversal[k];
+            h.increment_direction = self.direction[k];
+        }
+        if self.layout.thornton {
+            let t = self.thornton[k];
+            h.max_overlap_m = t.max_overlap_m;
+            h.max_normal_force_n = t.max_normal_force_n;
+            h.yielded = t.yielded;
+        }
+        h
+    }
+
+    pub fn heap_bytes(&self) -> usize {
+        self.touching.capacity()
+            + (self.tangential.capacity() + self.reversal.capacity() + self.direction.capacity())
+                * std::mem::size_of::<Vec3>()
+            + self.thornton.capacity() * std::mem::size_of::<ThorntonState>()
+    }
+}
+
+impl ColumnsMut<'_> {
+    /// The history of local slot k, for a contact that is touching.
+    #[inline(always)]
+    pub fn load(&self, k: usize) -> ContactHistory {
+        let mut h = ContactHistory {
+            active: self.touching[k],
+            ..ContactHistory::INACTIVE
+        };
+        if self.layout.tangential {
+            h.tangential = self.tangential[k];
+        }
+        if self.layout.walton_braun {
+            h.reversal_force_n = self.reversal[k];
+            h.increment_direction = self.direction[k];
+        }
+        if self.layout.thornton {
+            let t = self.thornton[k];
+            h.max_overlap_m = t.max_overlap_m;
+            h.max_normal_force_n = t.max_normal_force_n;
+            h.yielded = t.yielded;
+        }
+        h
+    }
+
+    #[inline(always)]
+    pub fn save(&mut self, k: usize, h: &ContactHistory) {
+        self.touching[k] = h.active;
+        if self.layout.tangential {
+            self.tangential[k] = h.tangential;
+        }
+        if self.layout.walton_braun {
+            self.reversal[k] = h.reversal_force_n;
+            self.direction[k] = h.increment_direction;
+        }
+        if self.layout.thornton {
+            self.thornton[k] = ThorntonState {
+                max_overlap_m: h.max_overlap_m,
+                max_normal_force_n: h.max_normal_force_n,
+                yielded: h.yielded,
+            };
+        }
+    }
+
+    /// Marks local slot k as not touching and clears its history, if it was touching.
+    #[inline(always)]
+    pub fn release(&mut self, k: usize) {
+        if self.touching[k] {
+            self.save(k, &ContactHistory::INACTIVE);
+        }
+    }
+}
+
+/// Histories for the pair and wall slots of a [`NeighborList`].
 #[derive(Debug, Clone, Default)]
 pub struct AlignedHistory {
-    pub pair: Vec<ContactHistory>,
-    pub wall: Vec<ContactHistory>,
-    pub pair_touching: Vec<bool>,
-    pub wall_touching: Vec<bool>,
+    pub pair: HistoryColumns,
+    pub wall: HistoryColumns,
 }
 
 impl AlignedHistory {
@@ -49,17 +241,17 @@ impl AlignedHistory {
         let mut store = ContactStore::default();
         for i in 0..n {
             for k in list.pairs_of(i) {
-                if self.pair_touching[k] {
+                if self.pair.touching[k] {
                     store
                         .pairs
-                        .push((ParticleId(i as u32), ParticleId(list.partner[k]), self.pair[k]));
+                        .push((ParticleId(i as u32), ParticleId(list.partner[k]), self.pair.get(k)));
                 }
             }
             for k in list.walls_of(i) {
-                if self.wall_touching[k] {
+                if self.wall.touching[k] {
                     store
                         .walls
-                        .push((ParticleId(i as u32), WallId(list.wall_partner[k]), self.wall[k]));
+                        .push((ParticleId(i as u32), WallId(list.wall_partner[k]), self.wall.get(k)));
                 }
             }
         }
@@ -69,54 +261,46 @@ impl AlignedHistory {
     /// Histories for a freshly built `list`, taking every contact of `store` whose pair is a candidate of `list`.
     /// Returns how many active contacts of the store found no slot (a contact that should have been found: the
     /// caller treats a non-zero count as a bug).
-    pub fn from_store(store: &ContactStore, list: &NeighborList) -> (AlignedHistory, usize) {
+    pub fn from_store(store: &ContactStore, list: &NeighborList, layout: HistoryLayout) -> (AlignedHistory, usize) {
         let n = list.start.len().saturating_sub(1);
-        let mut pair = vec![ContactHistory::INACTIVE; list.partner.len()];
-        let mut wall = vec![ContactHistory::INACTIVE; list.wall_partner.len()];
+        let mut pair = HistoryColumns::new(list.partner.len(), layout);
+        let mut wall = HistoryColumns::new(list.wall_partner.len(), layout);
         let mut orphans = 0;
-        let mut next_pair = store.pairs.iter().peekable();
-        let mut next_wall = store.walls.iter().peekable();
-        for i in 0..n {
-            let slots = list.pairs_of(i);
-            let partners = &list.partner[slots.clone()];
-            while let Some((pi, pj, h)) = next_pair.next_if(|(pi, _, _)| pi.index() <= i) {
-                match (pi.index() == i)
-                    .then(|| partners.binary_search(&pj.0))
-                    .and_then(Result::ok)
-                {
-                    Some(offset) => pair[slots.start + offset] = *h,
-                    None => orphans += 1,
+        {
+            let mut pair_view = pair.view();
+            let mut wall_view = wall.view();
+            let mut next_pair = store.pairs.iter().peekable();
+            let mut next_wall = store.walls.iter().peekable();
+            for i in 0..n {
+                let slots = list.pairs_of(i);
+                let partners = &list.partner[slots.clone()];
+                while let Some((pi, pj, h)) = next_pair.next_if(|(pi, _, _)| pi.index() <= i) {
+                    match (pi.index() == i)
+                        .then(|| partners.binary_search(&pj.0))
+                        .and_then(Result::ok)
+                    {
+                        Some(offset) => pair_view.save(slots.start + offset, h),
+                        None => orphans += 1,
+                    }
+                }
+                let slots = list.walls_of(i);
+                let partners = &list.wall_partner[slots.clone()];
+                while let Some((pi, w, h)) = next_wall.next_if(|(pi, _, _)| pi.index() <= i) {
+                    match (pi.index() == i)
+                        .then(|| partners.binary_search(&w.0))
+                        .and_then(Result::ok)
+                    {
+                        Some(offset) => wall_view.save(slots.start + offset, h),
+                        None => orphans += 1,
+                    }
                 }
             }
-            let slots = list.walls_of(i);
-            let partners = &list.wall_partner[slots.clone()];
-            while let Some((pi, w, h)) = next_wall.next_if(|(pi, _, _)| pi.index() <= i) {
-                match (pi.index() == i)
-                    .then(|| partners.binary_search(&w.0))
-                    .and_then(Result::ok)
-                {
-                    Some(offset) => wall[slots.start + offset] = *h,
-                    None => orphans += 1,
-                }
-            }
+            orphans += next_pair.count() + next_wall.count();
         }
-        orphans += next_pair.count() + next_wall.count();
-        let pair_touching = pair.iter().map(|h| h.active).collect();
-        let wall_touching = wall.iter().map(|h| h.active).collect();
-        (
-            AlignedHistory {
-                pair,
-                wall,
-                pair_touching,
-                wall_touching,
-            },
-            orphans,
-        )
+        (AlignedHistory { pair, wall }, orphans)
     }
 
     pub fn heap_bytes(&self) -> usize {
-        (self.pair.capacity() + self.wall.capacity()) * std::mem::size_of::<ContactHistory>()
-            + self.pair_touching.capacity()
-            + self.wall_touching.capacity()
+        self.pair.heap_bytes() + self.wall.heap_bytes()
     }
 }

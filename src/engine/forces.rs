@@ -5,13 +5,19 @@
 //! scatters directly (f_i += F, f_j −= F), which produces exactly that order; on several threads each pair's result
 //! is written to a per-slot buffer in parallel and then gathered per particle in that same order. Both paths run
 //! the same per-contact kernel, so one and N threads give bit-identical forces.
+//!
+//! The second half kick of velocity Verlet is fused into this pass: a particle's force is complete when its own
+//! iteration ends (its contacts as second particle came earlier), and no later pair reads its velocity, so it is
+//! kicked right there instead of in another sweep over memory.
+
+use std::cell::Cell;
 
 use rayon::prelude::*;
 
 use super::Vec3;
-use super::contacts::AlignedHistory;
+use super::contacts::{AlignedHistory, ColumnsMut};
 use super::geometry::Wall;
-use super::models::{ContactHistory, ContactKinematics, ContactLaw, PairTable};
+use super::models::{ContactKinematics, ContactLaw, PairTable};
 use super::neighbor::NeighborList;
 use super::particles::{ParticleId, Particles};
 use super::simulation::SimConfig;
@@ -83,6 +89,51 @@ impl WorstOverlap {
     }
 }
 
+/// The second half kick, applied to each particle as soon as its force is complete.
+#[derive(Debug, Clone, Copy)]
+pub struct HalfKick {
+    pub gravity: Vec3,
+    pub dt_s: f64,
+}
+
+/// Read access to velocities: plain slices while nothing writes them, cells while the serial loop kicks in place.
+trait Velocities {
+    fn v(&self, i: usize) -> Vec3;
+    fn w(&self, i: usize) -> Vec3;
+}
+
+struct Plain<'a> {
+    v: &'a [Vec3],
+    w: &'a [Vec3],
+}
+
+impl Velocities for Plain<'_> {
+    #[inline(always)]
+    fn v(&self, i: usize) -> Vec3 {
+        self.v[i]
+    }
+    #[inline(always)]
+    fn w(&self, i: usize) -> Vec3 {
+        self.w[i]
+    }
+}
+
+struct Cells<'a> {
+    v: &'a [Cell<Vec3>],
+    w: &'a [Cell<Vec3>],
+}
+
+impl Velocities for Cells<'_> {
+    #[inline(always)]
+    fn v(&self, i: usize) -> Vec3 {
+        self.v[i].get()
+    }
+    #[inline(always)]
+    fn w(&self, i: usize) -> Vec3 {
+        self.w[i].get()
+    }
+}
+
 /// Everything one contact evaluation needs that does not change during the pass.
 struct Context<'a> {
     config: &'a SimConfig,
@@ -91,6 +142,7 @@ struct Context<'a> {
     p: &'a Particles,
     wall_angle: &'a [f64],
     dt_s: f64,
+    kick: Option<HalfKick>,
 }
 
 /// Result of one particle–particle contact: force on i, torques on i and j.
@@ -102,14 +154,15 @@ struct PairResult {
 }
 
 impl Context<'_> {
-    /// Evaluates the pair (i, j) if it overlaps; otherwise clears its history.
+    /// Evaluates the pair (i, j) in local history slot `k` if it overlaps; otherwise releases the slot.
     #[inline(always)]
     fn pair(
         &self,
         i: usize,
         j: usize,
-        touching: &mut bool,
-        hist: &mut ContactHistory,
+        vel: &impl Velocities,
+        hist: &mut ColumnsMut,
+        k: usize,
         worst: &mut WorstOverlap,
     ) -> Option<PairResult> {
         let p = self.p;
@@ -118,29 +171,27 @@ impl Context<'_> {
         let (ri, rj) = (p.radius_m[i], p.radius_m[j]);
         let reach = ri + rj;
         if dist2 >= reach * reach {
-            if *touching {
-                *touching = false;
-                *hist = ContactHistory::INACTIVE;
-            }
+            hist.release(k);
             return None;
         }
-        *touching = true;
         let dist = dist2.sqrt();
         let n = d / dist;
         let overlap = reach - dist;
         worst.note(overlap, ri.min(rj), i, j as u32);
-        let (wi, wj) = (p.angular_velocity_rad_per_s[i], p.angular_velocity_rad_per_s[j]);
+        let (wi, wj) = (vel.w(i), vel.w(j));
         let (mi, mj) = (p.mass_kg[i], p.mass_kg[j]);
-        let k = ContactKinematics {
+        let kin = ContactKinematics {
             normal: n,
             overlap_m: overlap,
             effective_radius_m: ri * rj / reach,
             effective_mass_kg: mi * mj / (mi + mj),
-            contact_velocity: p.velocity_m_per_s[i] - p.velocity_m_per_s[j] - (wi * ri + wj * rj).cross(&n),
+            contact_velocity: vel.v(i) - vel.v(j) - (wi * ri + wj * rj).cross(&n),
             relative_angular_velocity: wi - wj,
         };
         let mat = self.table.get(p.species[i], p.species[j]);
-        let out = self.law.evaluate(mat, &k, self.dt_s, hist);
+        let mut h = hist.load(k);
+        let out = self.law.evaluate(mat, &kin, self.dt_s, &mut h);
+        hist.save(k, &h);
         let nxft = n.cross(&out.tangential_force);
         Some(PairResult {
             force: out.force,
@@ -149,15 +200,18 @@ impl Context<'_> {
         })
     }
 
-    /// Adds the wall contacts of particle i to (f, t), in ascending wall order.
-    #[inline(always)]
+    /// Adds the wall contacts of particle i (velocity `vi`, angular velocity `wi`) to (f, t), in ascending wall
+    /// order; `hist` holds exactly i's wall slots.
     #[allow(clippy::too_many_arguments)]
+    #[inline(always)]
     fn walls(
         &self,
         i: usize,
+        vi: Vec3,
+        wi: Vec3,
         wall_ids: &[u16],
-        touching: &mut [bool],
-        hist: &mut [ContactHistory],
+        hist: &mut ColumnsMut,
+        first_slot: usize,
         f: &mut Vec3,
         t: &mut Vec3,
         worst: &mut WorstOverlap,
@@ -165,38 +219,76 @@ impl Context<'_> {
         let p = self.p;
         let x = p.position_m[i];
         let ri = p.radius_m[i];
-        for ((h, on), &w) in hist.iter_mut().zip(touching.iter_mut()).zip(wall_ids) {
+        for (offset, &w) in wall_ids.iter().enumerate() {
+            let k = first_slot + offset;
             let wall = &self.config.walls[w as usize];
             let prox = wall.proximity(&x, self.wall_angle[w as usize]);
             let overlap = ri - prox.gap_m;
             if overlap <= 0.0 {
-                if *on {
-                    *on = false;
-                    *h = ContactHistory::INACTIVE;
-                }
+                hist.release(k);
                 continue;
             }
-            *on = true;
             worst.note(overlap, ri, i, u32::MAX - w as u32);
             let n = prox.normal;
-            let wi = p.angular_velocity_rad_per_s[i];
-            let k = ContactKinematics {
+            let kin = ContactKinematics {
                 normal: n,
                 overlap_m: overlap,
                 effective_radius_m: ri,
                 effective_mass_kg: p.mass_kg[i],
-                contact_velocity: p.velocity_m_per_s[i] - (wi * ri).cross(&n) - prox.wall_velocity,
+                contact_velocity: vi - (wi * ri).cross(&n) - prox.wall_velocity,
                 relative_angular_velocity: wi - prox.wall_angular_velocity,
             };
             let mat = self.table.get(p.species[i], wall.species);
-            let out = self.law.evaluate(mat, &k, self.dt_s, h);
+            let mut h = hist.load(k);
+            let out = self.law.evaluate(mat, &kin, self.dt_s, &mut h);
+            hist.save(k, &h);
             *f += out.force;
             *t += -(n.cross(&out.tangential_force) * ri) + out.rolling_torque;
         }
     }
+
+    /// Finishes particle i once its force and torque are complete: pseudo-2-D projection, then the half kick.
+    /// Returns the kicked (v, ω).
+    #[inline(always)]
+    fn finish(&self, i: usize, f: &mut Vec3, t: &mut Vec3, v: Vec3, w: Vec3) -> (Vec3, Vec3) {
+        if self.config.pseudo_2d {
+            f.z = 0.0;
+            t.x = 0.0;
+            t.y = 0.0;
+        }
+        match self.kick {
+            None => (v, w),
+            Some(k) => {
+                let half_dt = 0.5 * k.dt_s;
+                let mut v = v + *f * (half_dt / self.p.mass_kg[i]) + k.gravity * half_dt;
+                let mut w = w + *t * (half_dt / self.p.inertia_kg_m2[i]);
+                if self.config.pseudo_2d {
+                    v.z = 0.0;
+                    w.x = 0.0;
+                    w.y = 0.0;
+                }
+                (v, w)
+            }
+        }
+    }
 }
 
-/// Computes contact forces and torques into `p.force_n` and `p.torque_n_m`. Returns the worst overlap.
+/// A vector is finite when the sum of its components is (a NaN or infinity anywhere propagates).
+#[inline(always)]
+fn finite(v: &Vec3) -> bool {
+    (v.x + v.y + v.z).is_finite()
+}
+
+/// What the force pass reports.
+#[derive(Debug, Clone, Copy)]
+pub struct ForcePass {
+    pub worst_overlap: WorstOverlap,
+    /// First particle whose kicked velocity or angular velocity is not finite.
+    pub non_finite: Option<usize>,
+}
+
+/// Computes contact forces and torques into `p.force_n` and `p.torque_n_m` and, with `kick`, applies the second
+/// half kick to every particle.
 #[allow(clippy::too_many_arguments)]
 pub fn compute_contact_forces(
     config: &SimConfig,
@@ -207,9 +299,12 @@ pub fn compute_contact_forces(
     history: &mut AlignedHistory,
     buffers: &mut PairBuffers,
     threads: usize,
-) -> WorstOverlap {
+    kick: Option<HalfKick>,
+) -> ForcePass {
     let mut force = std::mem::take(&mut p.force_n);
     let mut torque = std::mem::take(&mut p.torque_n_m);
+    let mut velocity = std::mem::take(&mut p.velocity_m_per_s);
+    let mut omega = std::mem::take(&mut p.angular_velocity_rad_per_s);
     let ctx = Context {
         config,
         law: &config.contact_law,
@@ -217,22 +312,27 @@ pub fn compute_contact_forces(
         p,
         wall_angle,
         dt_s,
+        kick,
     };
-    let worst = if threads <= 1 {
-        serial(&ctx, list, history, &mut force, &mut torque)
+    let pass = if threads <= 1 {
+        serial(&ctx, list, history, &mut force, &mut torque, &mut velocity, &mut omega)
     } else {
-        parallel(&ctx, list, history, buffers, &mut force, &mut torque)
+        parallel(
+            &ctx,
+            list,
+            history,
+            buffers,
+            &mut force,
+            &mut torque,
+            &mut velocity,
+            &mut omega,
+        )
     };
-    if config.pseudo_2d {
-        for (f, t) in force.iter_mut().zip(torque.iter_mut()) {
-            f.z = 0.0;
-            t.x = 0.0;
-            t.y = 0.0;
-        }
-    }
     p.force_n = force;
     p.torque_n_m = torque;
-    worst
+    p.velocity_m_per_s = velocity;
+    p.angular_velocity_rad_per_s = omega;
+    pass
 }
 
 fn serial(
@@ -241,37 +341,58 @@ fn serial(
     history: &mut AlignedHistory,
     force: &mut [Vec3],
     torque: &mut [Vec3],
-) -> WorstOverlap {
+    velocity: &mut [Vec3],
+    omega: &mut [Vec3],
+) -> ForcePass {
     let n = ctx.p.len();
     let mut worst = WorstOverlap::NONE;
+    let mut non_finite = None;
     force.fill(Vec3::zeros());
     torque.fill(Vec3::zeros());
+    let vel = Cells {
+        v: Cell::from_mut(velocity).as_slice_of_cells(),
+        w: Cell::from_mut(omega).as_slice_of_cells(),
+    };
+    let mut pairs = history.pair.view();
+    let mut walls = history.wall.view();
     for i in 0..n {
         let slots = list.pairs_of(i);
         for (k, &j) in slots.clone().zip(&list.partner[slots]) {
             let j = j as usize;
-            if let Some(r) = ctx.pair(i, j, &mut history.pair_touching[k], &mut history.pair[k], &mut worst) {
+            if let Some(r) = ctx.pair(i, j, &vel, &mut pairs, k, &mut worst) {
                 force[i] += r.force;
                 force[j] -= r.force;
                 torque[i] += r.torque_i;
                 torque[j] += r.torque_j;
             }
         }
-        let walls = list.walls_of(i);
+        let wall_slots = list.walls_of(i);
         let (mut f, mut t) = (force[i], torque[i]);
+        let (vi, wi) = (vel.v(i), vel.w(i));
         ctx.walls(
             i,
-            &list.wall_partner[walls.clone()],
-            &mut history.wall_touching[walls.clone()],
-            &mut history.wall[walls],
+            vi,
+            wi,
+            &list.wall_partner[wall_slots.clone()],
+            &mut walls,
+            wall_slots.start,
             &mut f,
             &mut t,
             &mut worst,
         );
+        let (v_new, w_new) = ctx.finish(i, &mut f, &mut t, vi, wi);
+        if non_finite.is_none() && !(finite(&v_new) && finite(&w_new)) {
+            non_finite = Some(i);
+        }
+        vel.v[i].set(v_new);
+        vel.w[i].set(w_new);
         force[i] = f;
         torque[i] = t;
     }
-    worst
+    ForcePass {
+        worst_overlap: worst,
+        non_finite,
+    }
 }
 
 /// Splits `data` into consecutive mutable pieces ending at the given offsets.
@@ -287,6 +408,7 @@ fn split_by_offsets<'a, T>(mut data: &'a mut [T], ends: &[usize]) -> Vec<&'a mut
     out
 }
 
+#[allow(clippy::too_many_arguments)]
 fn parallel(
     ctx: &Context,
     list: &NeighborList,
@@ -294,7 +416,9 @@ fn parallel(
     buffers: &mut PairBuffers,
     force: &mut [Vec3],
     torque: &mut [Vec3],
-) -> WorstOverlap {
+    velocity: &mut [Vec3],
+    omega: &mut [Vec3],
+) -> ForcePass {
     let n = ctx.p.len();
     let n_slots = list.pair_count();
     buffers.force_on_i.resize(n_slots, Vec3::zeros());
@@ -302,19 +426,19 @@ fn parallel(
     buffers.torque_on_j.resize(n_slots, Vec3::zeros());
     let chunk_bounds: Vec<usize> = (1..=n.div_ceil(CHUNK)).map(|c| (c * CHUNK).min(n)).collect();
 
-    // Pass 1: every pair slot, in parallel by chunks of first particles.
+    // Pass 1: every pair slot, in parallel by chunks of first particles; velocities are only read.
     let pair_ends: Vec<usize> = chunk_bounds.iter().map(|&hi| list.start[hi] as usize).collect();
-    let hist_parts = split_by_offsets(&mut history.pair, &pair_ends);
-    let touching_parts = split_by_offsets(&mut history.pair_touching, &pair_ends);
+    let hist_parts = history.pair.split(&pair_ends);
     let f_parts = split_by_offsets(&mut buffers.force_on_i, &pair_ends);
     let ti_parts = split_by_offsets(&mut buffers.torque_on_i, &pair_ends);
     let tj_parts = split_by_offsets(&mut buffers.torque_on_j, &pair_ends);
+    let vel = Plain { v: velocity, w: omega };
     let worst_pairs = hist_parts
         .into_par_iter()
-        .zip(touching_parts)
-        .zip(f_parts.into_par_iter().zip(ti_parts.into_par_iter().zip(tj_parts)))
+        .zip(f_parts)
+        .zip(ti_parts.into_par_iter().zip(tj_parts))
         .enumerate()
-        .map(|(c, ((hist, touching), (fb, (tib, tjb))))| {
+        .map(|(c, ((mut hist, fb), (tib, tjb)))| {
             let lo = c * CHUNK;
             let hi = chunk_bounds[c];
             let base = list.start[lo] as usize;
@@ -323,7 +447,7 @@ fn parallel(
                 for k in list.pairs_of(i) {
                     let j = list.partner[k] as usize;
                     let local = k - base;
-                    if let Some(r) = ctx.pair(i, j, &mut touching[local], &mut hist[local], &mut worst) {
+                    if let Some(r) = ctx.pair(i, j, &vel, &mut hist, local, &mut worst) {
                         fb[local] = r.force;
                         tib[local] = r.torque_i;
                         tjb[local] = r.torque_j;
@@ -334,21 +458,22 @@ fn parallel(
         })
         .reduce(|| WorstOverlap::NONE, WorstOverlap::max);
 
-    // Pass 2: gather per particle in the serial order, then walls.
-    let pair_touching = &history.pair_touching;
+    // Pass 2: gather per particle in the serial order, then walls, then the kick.
+    let pair_touching = &history.pair.touching;
     let wall_ends: Vec<usize> = chunk_bounds.iter().map(|&hi| list.wall_start[hi] as usize).collect();
-    let wall_hist_parts = split_by_offsets(&mut history.wall, &wall_ends);
-    let wall_touching_parts = split_by_offsets(&mut history.wall_touching, &wall_ends);
-    let worst_walls = force
+    let wall_parts = history.wall.split(&wall_ends);
+    let (worst_walls, non_finite) = force
         .par_chunks_mut(CHUNK)
         .zip(torque.par_chunks_mut(CHUNK))
-        .zip(wall_hist_parts.into_par_iter().zip(wall_touching_parts))
+        .zip(velocity.par_chunks_mut(CHUNK).zip(omega.par_chunks_mut(CHUNK)))
+        .zip(wall_parts)
         .enumerate()
-        .map(|(c, ((fc, tc), (wall_hist, wall_touching)))| {
+        .map(|(c, (((fc, tc), (vc, wc)), mut wall_hist))| {
             let lo = c * CHUNK;
             let wall_base = list.wall_start[lo] as usize;
             let mut worst = WorstOverlap::NONE;
-            for (offset, (f_out, t_out)) in fc.iter_mut().zip(tc.iter_mut()).enumerate() {
+            let mut non_finite = None;
+            for offset in 0..fc.len() {
                 let p = lo + offset;
                 let mut f = Vec3::zeros();
                 let mut t = Vec3::zeros();
@@ -367,21 +492,35 @@ fn parallel(
                     }
                 }
                 let walls = list.walls_of(p);
-                let local = walls.start - wall_base..walls.end - wall_base;
+                let (vi, wi) = (vc[offset], wc[offset]);
                 ctx.walls(
                     p,
-                    &list.wall_partner[walls],
-                    &mut wall_touching[local.clone()],
-                    &mut wall_hist[local],
+                    vi,
+                    wi,
+                    &list.wall_partner[walls.clone()],
+                    &mut wall_hist,
+                    walls.start - wall_base,
                     &mut f,
                     &mut t,
                     &mut worst,
                 );
-                *f_out = f;
-                *t_out = t;
+                let (v_new, w_new) = ctx.finish(p, &mut f, &mut t, vi, wi);
+                if non_finite.is_none() && !(finite(&v_new) && finite(&w_new)) {
+                    non_finite = Some(p);
+                }
+                vc[offset] = v_new;
+                wc[offset] = w_new;
+                fc[offset] = f;
+                tc[offset] = t;
             }
-            worst
+            (worst, non_finite)
         })
-        .reduce(|| WorstOverlap::NONE, WorstOverlap::max);
-    worst_pairs.max(worst_walls)
+        .reduce(
+            || (WorstOverlap::NONE, None),
+            |a, b| (a.0.max(b.0), a.1.min(b.1).or(a.1).or(b.1)),
+        );
+    ForcePass {
+        worst_overlap: worst_pairs.max(worst_walls),
+        non_finite,
+    }
 }

@@ -2,8 +2,8 @@
 //! half kick → drift → forces (with half-step velocities) → half kick.
 //!
 //! The first half kick, the drift, the lost-particle check and the neighbour-list displacement check are one pass
-//! over the particles ([`kick_drift`]); the second half kick is another ([`kick`]). The integrator is memory-bound,
-//! so passes, not arithmetic, set its cost. Each particle is updated independently, so the parallel loops are
+//! over the particles ([`kick_drift`]); the second half kick is fused into the force pass (`forces.rs`). The
+//! integrator is memory-bound, so passes, not arithmetic, set its cost. Each particle is updated independently, so the parallel loops are
 //! trivially deterministic.
 
 use rayon::prelude::*;
@@ -77,7 +77,9 @@ pub fn kick_drift(
             let mut bad = None;
             let mut max_d2 = 0.0f64;
             for k in 0..x.len() {
-                half_kick_one(&mut v[k], &mut w[k], &f[k], &t[k], m[k], inertia[k], &g_half_dt, half_dt);
+                half_kick_one(
+                    &mut v[k], &mut w[k], &f[k], &t[k], m[k], inertia[k], &g_half_dt, half_dt,
+                );
                 if pseudo_2d {
                     v[k].z = 0.0;
                     w[k].x = 0.0;
@@ -99,32 +101,4 @@ pub fn kick_drift(
             (max_d2, bad)
         })
         .reduce(|| (0.0, None), |a, b| (a.0.max(b.0), first(a.1, b.1)))
-}
-
-/// Second half kick. Returns the first particle whose velocity or angular velocity is not finite.
-pub fn kick(p: &mut Particles, gravity: &Vec3, dt_s: f64, pseudo_2d: bool) -> Option<usize> {
-    let half_dt = 0.5 * dt_s;
-    let g_half_dt = gravity * half_dt;
-    p.velocity_m_per_s
-        .par_chunks_mut(CHUNK)
-        .zip(p.angular_velocity_rad_per_s.par_chunks_mut(CHUNK))
-        .zip(p.force_n.par_chunks(CHUNK).zip(p.torque_n_m.par_chunks(CHUNK)))
-        .zip(p.mass_kg.par_chunks(CHUNK).zip(p.inertia_kg_m2.par_chunks(CHUNK)))
-        .enumerate()
-        .map(|(c, (((v, w), (f, t)), (m, inertia)))| {
-            let mut bad = None;
-            for k in 0..v.len() {
-                half_kick_one(&mut v[k], &mut w[k], &f[k], &t[k], m[k], inertia[k], &g_half_dt, half_dt);
-                if pseudo_2d {
-                    v[k].z = 0.0;
-                    w[k].x = 0.0;
-                    w[k].y = 0.0;
-                }
-                if bad.is_none() && !(finite(&v[k]) && finite(&w[k])) {
-                    bad = Some(c * CHUNK + k);
-                }
-            }
-            bad
-        })
-        .reduce(|| None, |a, b| a.min(b).or(a).or(b))
 }

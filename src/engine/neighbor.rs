@@ -57,7 +57,13 @@ impl NeighborList {
     /// True when the list may miss a contact: some particle moved more than skin/2 since the build
     /// (`max_displacement2_m2` is the largest squared displacement; two particles closing on each other use up the
     /// skin), a moving wall's surface moved more than skin/2, or the particle count changed.
-    pub fn needs_rebuild(&self, n_particles: usize, max_displacement2_m2: f64, walls: &[Wall], wall_angle: &[f64]) -> bool {
+    pub fn needs_rebuild(
+        &self,
+        n_particles: usize,
+        max_displacement2_m2: f64,
+        walls: &[Wall],
+        wall_angle: &[f64],
+    ) -> bool {
         if self.reference_position.len() != n_particles || self.builds == 0 {
             return true;
         }
@@ -249,11 +255,7 @@ mod tests {
     /// The cell-list half list equals the brute-force one, on a periodic box with few cells per axis.
     #[test]
     fn matches_brute_force_with_periodic_axes() {
-        let domain = Domain {
-            lo_m: Vec3::zeros(),
-            hi_m: Vec3::new(1.0, 0.5, 0.3),
-            periodic: [true, false, true],
-        };
+        let domain = Domain::new(Vec3::zeros(), Vec3::new(1.0, 0.5, 0.3), [true, false, true]);
         let mut state = 12345u64;
         let mut rnd = || {
             state = state

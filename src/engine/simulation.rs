@@ -9,9 +9,9 @@ use std::sync::Arc;
 use std::time::{Duration, Instant};
 
 use super::contacts::AlignedHistory;
-use super::forces::{PairBuffers, compute_contact_forces};
+use super::forces::{ForcePass, HalfKick, PairBuffers, compute_contact_forces};
 use super::geometry::{Domain, Gravity, Wall};
-use super::integrate::{BadParticle, kick, kick_drift};
+use super::integrate::{BadParticle, kick_drift};
 use super::models::{ContactLaw, PairTable};
 use super::neighbor::NeighborList;
 use super::particles::{ParticleId, Particles, SpeciesTable};
@@ -85,8 +85,8 @@ impl Simulation {
         };
         sim.refresh_neighbors();
         // The first half kick needs F(0). With dt = 0 the tangential springs do not move.
-        let worst = sim.with_pool(|s| s.forces(0.0));
-        sim.check_overlap(worst)?;
+        let pass = sim.with_pool(|s| s.forces(0.0, None));
+        sim.check_overlap(pass.worst_overlap)?;
         Ok(sim)
     }
 
@@ -114,7 +114,8 @@ impl Simulation {
             &sim.config.walls,
             &sim.wall_angle_rad,
         );
-        let (history, orphans) = AlignedHistory::from_store(&state.contacts, &sim.list);
+        let layout = sim.config.contact_law.history_layout();
+        let (history, orphans) = AlignedHistory::from_store(&state.contacts, &sim.list, layout);
         if orphans > 0 {
             return Err(NumericalError::OrphanContacts { count: orphans });
         }
@@ -146,8 +147,8 @@ impl Simulation {
     /// Number of active particle–particle and particle–wall contacts.
     pub fn contact_counts(&self) -> (usize, usize) {
         (
-            self.history.pair_touching.iter().filter(|&&t| t).count(),
-            self.history.wall_touching.iter().filter(|&&t| t).count(),
+            self.history.pair.touching.iter().filter(|&&t| t).count(),
+            self.history.wall.touching.iter().filter(|&&t| t).count(),
         )
     }
 
@@ -156,7 +157,7 @@ impl Simulation {
         let mut z = vec![0u32; self.particles.len()];
         for i in 0..self.particles.len() {
             for k in self.list.pairs_of(i) {
-                if self.history.pair_touching[k] {
+                if self.history.pair.touching[k] {
                     z[i] += 1;
                     z[self.list.partner[k] as usize] += 1;
                 }
@@ -215,21 +216,28 @@ impl Simulation {
         self.step += 1;
         self.time_s += dt;
         let t1 = Instant::now();
-        if self.list.needs_rebuild(self.particles.len(), max_displacement2, &config.walls, &self.wall_angle_rad) {
+        if self.list.needs_rebuild(
+            self.particles.len(),
+            max_displacement2,
+            &config.walls,
+            &self.wall_angle_rad,
+        ) {
             self.refresh_neighbors();
         }
         let t2 = Instant::now();
-        let worst = self.forces(dt);
+        let kick = HalfKick {
+            gravity: config.gravity.at(self.time_s),
+            dt_s: dt,
+        };
+        let pass = self.forces(dt, Some(kick));
         let t3 = Instant::now();
-        let g1 = config.gravity.at(self.time_s);
-        if let Some(i) = kick(&mut self.particles, &g1, dt, config.pseudo_2d) {
-            return Err(self.non_finite(i));
-        }
-        let t4 = Instant::now();
-        self.timers.integrate += (t1 - t0) + (t4 - t3);
+        self.timers.integrate += t1 - t0;
         self.timers.neighbor += t2 - t1;
         self.timers.force += t3 - t2;
-        self.check_overlap(worst)
+        if let Some(i) = pass.non_finite {
+            return Err(self.non_finite(i));
+        }
+        self.check_overlap(pass.worst_overlap)
     }
 
     fn non_finite(&self, i: usize) -> NumericalError {
@@ -264,7 +272,8 @@ impl Simulation {
         Ok(())
     }
 
-    fn forces(&mut self, dt: f64) -> super::forces::WorstOverlap {
+    /// Contact forces at the current positions; with `kick`, also the second half kick.
+    fn forces(&mut self, dt: f64, kick: Option<HalfKick>) -> ForcePass {
         let threads = self.threads();
         compute_contact_forces(
             &self.config,
@@ -275,6 +284,7 @@ impl Simulation {
             &mut self.history,
             &mut self.buffers,
             threads,
+            kick,
         )
     }
 
@@ -289,7 +299,7 @@ impl Simulation {
             &c.walls,
             &self.wall_angle_rad,
         );
-        let (history, orphans) = AlignedHistory::from_store(&store, &self.list);
+        let (history, orphans) = AlignedHistory::from_store(&store, &self.list, c.contact_law.history_layout());
         // A contact is always a candidate of a list built from the same positions.
         debug_assert_eq!(orphans, 0, "contacts lost in a neighbour-list rebuild");
         self.history = history;

@@ -134,11 +134,7 @@ mod tests {
 
     #[test]
     fn minimum_image_on_periodic_axis_only() {
-        let d = Domain {
-            lo_m: Vec3::zeros(),
-            hi_m: Vec3::new(1.0, 1.0, 1.0),
-            periodic: [true, false, false],
-        };
+        let d = Domain::new(Vec3::zeros(), Vec3::new(1.0, 1.0, 1.0), [true, false, false]);
         let s = d.separation(&Vec3::new(0.95, 0.9, 0.0), &Vec3::new(0.05, 0.1, 0.0));
         assert!((s.x + 0.1).abs() < 1e-12 && (s.y - 0.8).abs() < 1e-12);
     }

@@ -12,6 +12,7 @@ use super::pair_table::PairMaterial;
 use super::rolling::RollingModel;
 use super::tangential::TangentialModel;
 use crate::engine::Vec3;
+use crate::engine::contacts::HistoryLayout;
 
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -51,6 +52,15 @@ impl ContactLaw {
     /// Names of the slot models, as stored in checkpoints and results.
     pub fn model_names(&self) -> [&'static str; 3] {
         [self.normal.name(), self.tangential.name(), self.rolling.name()]
+    }
+
+    /// The history columns this law reads and writes.
+    pub fn history_layout(&self) -> HistoryLayout {
+        HistoryLayout {
+            tangential: true,
+            walton_braun: matches!(self.tangential, TangentialModel::WaltonBraun { .. }),
+            thornton: matches!(self.normal, NormalModel::Thornton { .. }),
+        }
     }
 
     /// Evaluates one overlapping contact and updates its history.
