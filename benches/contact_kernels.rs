@@ -16,6 +16,8 @@ fn kernels(c: &mut Criterion) {
         friction_coefficient: 0.3,
         yield_force_n: 0.05,
         rolling_friction_coefficient: 0.0,
+        viscoelastic_beta: 0.0,
+        tangential_damping_ratio: 1.0,
     };
     let k = ContactKinematics {
         normal: Vec3::new(0.0, 0.6, 0.8),

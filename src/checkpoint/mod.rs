@@ -500,35 +500,6 @@ mod tests {
         }
     }
 
-    fn f64s_differ(a: &[f64], b: &[f64]) -> bool {
-        a.len() != b.len() || a.iter().zip(b).any(|(x, y)| x.to_bits() != y.to_bits())
-    }
-
-    fn vecs_differ(a: &[Vec3], b: &[Vec3]) -> bool {
-        a.len() != b.len() || a.iter().zip(b).any(|(x, y)| f64s_differ(x.as_slice(), y.as_slice()))
-    }
-
-    fn history_diff(a: &ContactHistory, b: &ContactHistory) -> Option<&'static str> {
-        let vec = |x: &Vec3, y: &Vec3| f64s_differ(x.as_slice(), y.as_slice());
-        if a.active != b.active {
-            Some("active")
-        } else if a.yielded != b.yielded {
-            Some("yielded")
-        } else if vec(&a.tangential, &b.tangential) {
-            Some("tangential")
-        } else if vec(&a.reversal_force_n, &b.reversal_force_n) {
-            Some("reversal_force_n")
-        } else if vec(&a.increment_direction, &b.increment_direction) {
-            Some("increment_direction")
-        } else if a.max_overlap_m.to_bits() != b.max_overlap_m.to_bits() {
-            Some("max_overlap_m")
-        } else if a.max_normal_force_n.to_bits() != b.max_normal_force_n.to_bits() {
-            Some("max_normal_force_n")
-        } else {
-            None
-        }
-    }
-
     fn round_trip(state: &SimState, meta: &CheckpointMeta) {
         let dir = tempfile::tempdir().expect("tempdir");
         let path = dir.path().join("ckpt-000000000001.h5");

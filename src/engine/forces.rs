@@ -16,6 +16,7 @@ use rayon::prelude::*;
 
 use super::Vec3;
 use super::contacts::{AlignedHistory, ColumnsMut};
+use super::integrate::{InverseInertia, half_kick_one};
 use super::geometry::Wall;
 use super::models::{ContactKinematics, ContactLaw, PairTable};
 use super::neighbor::NeighborList;
@@ -60,6 +61,10 @@ impl WorstOverlap {
 
     #[inline]
     fn note(&mut self, overlap_m: f64, smaller_radius_m: f64, particle: usize, partner: u32) {
+        // Multiply first: the division happens only for a new worst, not for every contact.
+        if overlap_m <= self.ratio * smaller_radius_m {
+            return;
+        }
         let ratio = overlap_m / smaller_radius_m;
         if ratio > self.ratio {
             *self = WorstOverlap {
@@ -140,6 +145,7 @@ struct Context<'a> {
     law: &'a ContactLaw,
     table: &'a PairTable,
     p: &'a Particles,
+    inverse: &'a InverseInertia,
     wall_angle: &'a [f64],
     dt_s: f64,
     kick: Option<HalfKick>,
@@ -175,7 +181,7 @@ impl Context<'_> {
             return None;
         }
         let dist = dist2.sqrt();
-        let n = d / dist;
+        let n = d * (1.0 / dist);
         let overlap = reach - dist;
         worst.note(overlap, ri.min(rj), i, j as u32);
         let (wi, wj) = (vel.w(i), vel.w(j));
@@ -260,8 +266,17 @@ impl Context<'_> {
             None => (v, w),
             Some(k) => {
                 let half_dt = 0.5 * k.dt_s;
-                let mut v = v + *f * (half_dt / self.p.mass_kg[i]) + k.gravity * half_dt;
-                let mut w = w + *t * (half_dt / self.p.inertia_kg_m2[i]);
+                let (mut v, mut w) = (v, w);
+                half_kick_one(
+                    &mut v,
+                    &mut w,
+                    f,
+                    t,
+                    self.inverse.inv_mass_per_kg[i],
+                    self.inverse.inv_inertia_per_kg_m2[i],
+                    &(k.gravity * half_dt),
+                    half_dt,
+                );
                 if self.config.pseudo_2d {
                     v.z = 0.0;
                     w.x = 0.0;
@@ -293,6 +308,7 @@ pub struct ForcePass {
 pub fn compute_contact_forces(
     config: &SimConfig,
     p: &mut Particles,
+    inverse: &InverseInertia,
     wall_angle: &[f64],
     dt_s: f64,
     list: &NeighborList,
@@ -310,6 +326,7 @@ pub fn compute_contact_forces(
         law: &config.contact_law,
         table: &config.pair_table,
         p,
+        inverse,
         wall_angle,
         dt_s,
         kick,

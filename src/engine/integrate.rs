@@ -14,55 +14,55 @@ use super::particles::Particles;
 
 const CHUNK: usize = 2048;
 
-/// What went wrong with a particle during a pass.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum BadParticle {
-    NonFinite(usize),
-    Lost(usize),
+/// Inverse masses and moments of inertia, derived once from the particle arrays (never checkpointed: they follow
+/// from `mass_kg` and `inertia_kg_m2` exactly), so that each half kick multiplies instead of dividing.
+#[derive(Debug, Clone, Default)]
+pub struct InverseInertia {
+    pub inv_mass_per_kg: Vec<f64>,
+    pub inv_inertia_per_kg_m2: Vec<f64>,
 }
 
-impl BadParticle {
-    fn index(self) -> usize {
-        match self {
-            BadParticle::NonFinite(i) | BadParticle::Lost(i) => i,
+impl InverseInertia {
+    pub fn new(p: &Particles) -> Self {
+        InverseInertia {
+            inv_mass_per_kg: p.mass_kg.iter().map(|m| 1.0 / m).collect(),
+            inv_inertia_per_kg_m2: p.inertia_kg_m2.iter().map(|i| 1.0 / i).collect(),
         }
     }
 }
 
-fn first(a: Option<BadParticle>, b: Option<BadParticle>) -> Option<BadParticle> {
-    match (a, b) {
-        (Some(x), Some(y)) => Some(if x.index() <= y.index() { x } else { y }),
-        (x, None) => x,
-        (None, y) => y,
-    }
-}
-
-/// A vector is finite when the sum of its components is (a NaN or infinity anywhere propagates).
+/// v += ½dt (F/m + g), ω += ½dt T/I (the LIGGGHTS dtf/m form).
 #[inline(always)]
-fn finite(v: &Vec3) -> bool {
-    (v.x + v.y + v.z).is_finite()
+pub fn half_kick_one(
+    v: &mut Vec3,
+    w: &mut Vec3,
+    f: &Vec3,
+    t: &Vec3,
+    inv_m: f64,
+    inv_inertia: f64,
+    g_half_dt: &Vec3,
+    half_dt: f64,
+) {
+    *v += f * (half_dt * inv_m) + g_half_dt;
+    *w += t * (half_dt * inv_inertia);
 }
 
-/// v += ½dt (F/m + g), ω += ½dt T/I for particle k (LIGGGHTS' dtf/m form: one division per particle).
-#[inline(always)]
-fn half_kick_one(v: &mut Vec3, w: &mut Vec3, f: &Vec3, t: &Vec3, m: f64, inertia: f64, g_half_dt: &Vec3, half_dt: f64) {
-    *v += f * (half_dt / m) + g_half_dt;
-    *w += t * (half_dt / inertia);
-}
-
-/// First half of a step: half kick, drift (wrapped on periodic axes), and checks. Returns the largest squared
-/// displacement from `reference` (the positions at the last neighbour-list build; empty = skip) and the first
-/// particle that became non-finite or left the box.
+/// First half of a step: half kick and drift (wrapped on periodic axes). Returns the largest squared displacement
+/// from `reference` (the positions at the last neighbour-list build; empty = skip).
+///
+/// No checks here: velocities were checked finite by the kick that made them (`forces.rs`), so positions stay
+/// finite, and lost particles are looked for when the neighbour list is rebuilt (a particle cannot leave the box
+/// by a radius without moving more than half the skin).
 #[allow(clippy::too_many_arguments)]
 pub fn kick_drift(
     p: &mut Particles,
+    inverse: &InverseInertia,
     gravity: &Vec3,
     dt_s: f64,
     pseudo_2d: bool,
     domain: &Domain,
-    lost_tolerance_m: f64,
     reference: &[Vec3],
-) -> (f64, Option<BadParticle>) {
+) -> f64 {
     let half_dt = 0.5 * dt_s;
     let g_half_dt = gravity * half_dt;
     let check_displacement = reference.len() == p.len();
@@ -71,34 +71,38 @@ pub fn kick_drift(
         .zip(p.velocity_m_per_s.par_chunks_mut(CHUNK))
         .zip(p.angular_velocity_rad_per_s.par_chunks_mut(CHUNK))
         .zip(p.force_n.par_chunks(CHUNK).zip(p.torque_n_m.par_chunks(CHUNK)))
-        .zip(p.mass_kg.par_chunks(CHUNK).zip(p.inertia_kg_m2.par_chunks(CHUNK)))
+        .zip(
+            inverse
+                .inv_mass_per_kg
+                .par_chunks(CHUNK)
+                .zip(inverse.inv_inertia_per_kg_m2.par_chunks(CHUNK)),
+        )
         .enumerate()
-        .map(|(c, ((((x, v), w), (f, t)), (m, inertia)))| {
-            let mut bad = None;
+        .map(|(c, ((((x, v), w), (f, t)), (inv_m, inv_i)))| {
             let mut max_d2 = 0.0f64;
-            for k in 0..x.len() {
-                half_kick_one(
-                    &mut v[k], &mut w[k], &f[k], &t[k], m[k], inertia[k], &g_half_dt, half_dt,
-                );
+            let reference = if check_displacement { &reference[c * CHUNK..c * CHUNK + x.len()] } else { &[] };
+            let particles = x.iter_mut().zip(v.iter_mut()).zip(w.iter_mut()).zip(f.iter().zip(t)).zip(inv_m.iter().zip(inv_i));
+            for (k, ((((x, v), w), (f, t)), (&inv_m, &inv_i))) in particles.enumerate() {
+                half_kick_one(v, w, f, t, inv_m, inv_i, &g_half_dt, half_dt);
                 if pseudo_2d {
-                    v[k].z = 0.0;
-                    w[k].x = 0.0;
-                    w[k].y = 0.0;
+                    v.z = 0.0;
+                    w.x = 0.0;
+                    w.y = 0.0;
                 }
-                x[k] += v[k] * dt_s;
-                domain.wrap(&mut x[k]);
-                if check_displacement {
-                    max_d2 = max_d2.max(domain.separation(&x[k], &reference[c * CHUNK + k]).norm_squared());
-                }
-                if bad.is_none() {
-                    if !(finite(&x[k]) && finite(&v[k]) && finite(&w[k])) {
-                        bad = Some(BadParticle::NonFinite(c * CHUNK + k));
-                    } else if domain.is_lost(&x[k], lost_tolerance_m) {
-                        bad = Some(BadParticle::Lost(c * CHUNK + k));
-                    }
+                *x += *v * dt_s;
+                domain.wrap(x);
+                if let Some(x0) = reference.get(k) {
+                    max_d2 = max_d2.max(domain.separation(x, x0).norm_squared());
                 }
             }
-            (max_d2, bad)
+            max_d2
         })
-        .reduce(|| (0.0, None), |a, b| (a.0.max(b.0), first(a.1, b.1)))
+        .reduce(|| 0.0, f64::max)
+}
+
+/// The first particle outside the box by more than `tolerance_m` on a non-periodic axis, or not finite.
+pub fn find_lost(p: &Particles, domain: &Domain, tolerance_m: f64) -> Option<usize> {
+    p.position_m
+        .iter()
+        .position(|x| !(x.x + x.y + x.z).is_finite() || domain.is_lost(x, tolerance_m))
 }

@@ -11,7 +11,7 @@ use std::time::{Duration, Instant};
 use super::contacts::AlignedHistory;
 use super::forces::{ForcePass, HalfKick, PairBuffers, compute_contact_forces};
 use super::geometry::{Domain, Gravity, Wall};
-use super::integrate::{BadParticle, kick_drift};
+use super::integrate::{InverseInertia, find_lost, kick_drift};
 use super::models::{ContactLaw, PairTable};
 use super::neighbor::NeighborList;
 use super::particles::{ParticleId, Particles, SpeciesTable};
@@ -55,6 +55,7 @@ pub struct Simulation {
     list: NeighborList,
     history: AlignedHistory,
     buffers: PairBuffers,
+    inverse: InverseInertia,
     pool: Arc<rayon::ThreadPool>,
     pub timers: StageTimers,
 }
@@ -69,6 +70,7 @@ impl Simulation {
         threads: usize,
     ) -> Result<Self, NumericalError> {
         let n_walls = config.walls.len();
+        let inverse = InverseInertia::new(&particles);
         let mut sim = Simulation {
             config,
             particles,
@@ -80,6 +82,7 @@ impl Simulation {
             list: NeighborList::default(),
             history: AlignedHistory::default(),
             buffers: PairBuffers::default(),
+            inverse,
             pool: make_pool(threads),
             timers: StageTimers::default(),
         };
@@ -92,6 +95,7 @@ impl Simulation {
 
     /// Resumes from a checkpointed state; the next `step()` continues exactly where the saved run was.
     pub fn restore(config: Arc<SimConfig>, state: SimState, threads: usize) -> Result<Self, NumericalError> {
+        let inverse = InverseInertia::new(&state.particles);
         let mut sim = Simulation {
             config,
             particles: state.particles,
@@ -103,6 +107,7 @@ impl Simulation {
             list: NeighborList::default(),
             history: AlignedHistory::default(),
             buffers: PairBuffers::default(),
+            inverse,
             pool: make_pool(threads),
             timers: StageTimers::default(),
         };
@@ -173,10 +178,8 @@ impl Simulation {
 
     /// Advances `n` steps.
     pub fn run_steps(&mut self, n: u64) -> Result<(), NumericalError> {
-        for _ in 0..n {
-            self.step()?;
-        }
-        Ok(())
+        // One hand-over to the simulation's pool for all n steps (a hand-over costs a thread wake-up).
+        self.with_pool(|s| (0..n).try_for_each(|_| s.step_inner()))
     }
 
     /// Advances one time step.
@@ -189,39 +192,41 @@ impl Simulation {
         let config = Arc::clone(&self.config);
         let t0 = Instant::now();
         let g0 = config.gravity.at(self.time_s);
-        let lost_tolerance = self.particles.max_radius_m();
-        let (max_displacement2, bad) = kick_drift(
+        let max_displacement2 = kick_drift(
             &mut self.particles,
+            &self.inverse,
             &g0,
             dt,
             config.pseudo_2d,
             &config.domain,
-            lost_tolerance,
             self.list.reference_positions(),
         );
-        match bad {
-            Some(BadParticle::NonFinite(i)) => return Err(self.non_finite(i)),
-            Some(BadParticle::Lost(i)) => {
-                return Err(NumericalError::ParticleLost {
-                    step: self.step + 1,
-                    particle: ParticleId(i as u32),
-                    position_m: self.particles.position_m[i],
-                });
-            }
-            None => {}
-        }
         for (angle, wall) in self.wall_angle_rad.iter_mut().zip(&config.walls) {
             *angle += wall.angular_velocity_rad_per_s() * dt;
         }
         self.step += 1;
         self.time_s += dt;
         let t1 = Instant::now();
-        if self.list.needs_rebuild(
-            self.particles.len(),
-            max_displacement2,
-            &config.walls,
-            &self.wall_angle_rad,
-        ) {
+        if self
+            .list
+            .needs_rebuild(self.particles.len(), max_displacement2, &config.walls, &self.wall_angle_rad)
+        {
+            if let Some(i) = find_lost(&self.particles, &config.domain, self.particles.max_radius_m()) {
+                let position_m = self.particles.position_m[i];
+                return Err(if (position_m.x + position_m.y + position_m.z).is_finite() {
+                    NumericalError::ParticleLost {
+                        step: self.step,
+                        particle: ParticleId(i as u32),
+                        position_m,
+                    }
+                } else {
+                    NumericalError::NonFinite {
+                        step: self.step,
+                        particle: ParticleId(i as u32),
+                        field: "position",
+                    }
+                });
+            }
             self.refresh_neighbors();
         }
         let t2 = Instant::now();
@@ -278,6 +283,7 @@ impl Simulation {
         compute_contact_forces(
             &self.config,
             &mut self.particles,
+            &self.inverse,
             &self.wall_angle_rad,
             dt,
             &self.list,

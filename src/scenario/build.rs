@@ -163,7 +163,7 @@ pub fn build(spec: ScenarioSpec, path: &Path) -> Result<BuiltScenario, ConfigErr
         return Err(c.fail("output.keep_checkpoints", "expected at least 1"));
     }
 
-    let pair_table = PairTable::new(&species);
+    let pair_table = PairTable::new(&species, &spec.contact);
     let mut contact_time_s = f64::INFINITY;
     for (a, sa) in species.species.iter().enumerate() {
         for (b, sb) in species.species.iter().enumerate() {

@@ -64,7 +64,7 @@ impl ContactLaw {
     }
 
     /// Evaluates one overlapping contact and updates its history.
-    #[inline]
+    #[inline(always)]
     pub fn evaluate(
         &self,
         mat: &PairMaterial,
@@ -78,9 +78,7 @@ impl ContactLaw {
             .normal
             .force(mat, k.effective_radius_m, k.effective_mass_kg, k.overlap_m, vn, hist);
         let vt = k.contact_velocity - n * vn;
-        let ft = self
-            .tangential
-            .force(&self.normal, mat, k.effective_mass_kg, &normal, &n, &vt, dt_s, hist);
+        let ft = self.tangential.force(mat, &normal, &n, &vt, dt_s, hist);
         let rolling_torque = self.rolling.torque(
             mat.rolling_friction_coefficient,
             k.effective_radius_m,

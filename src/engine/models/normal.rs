@@ -51,6 +51,8 @@ pub struct NormalOutput {
     pub force_n: f64,
     /// Contact radius a (m); √(R* δ) for the Hertzian models, 0 for the linear model.
     pub contact_radius_m: f64,
+    /// Viscous normal damping coefficient γ_n of the Hertz model (kg/s); 0 for the others.
+    pub viscoelastic_damping_kg_per_s: f64,
 }
 
 impl NormalModel {
@@ -63,7 +65,7 @@ impl NormalModel {
     }
 
     /// Normal force for overlap `overlap_m` > 0. Updates the Thornton history (α_max, F_max, yielded).
-    #[inline]
+    #[inline(always)]
     pub fn force(
         &self,
         mat: &PairMaterial,
@@ -80,16 +82,18 @@ impl NormalModel {
             } => NormalOutput {
                 force_n: stiffness_n_per_m * overlap_m - damping_kg_per_s * normal_velocity_m_per_s,
                 contact_radius_m: 0.0,
+                viscoelastic_damping_kg_per_s: 0.0,
             },
-            NormalModel::Hertz { restitution } => {
+            NormalModel::Hertz { .. } => {
                 let contact_radius = (effective_radius_m * overlap_m).sqrt();
                 let e_star = mat.effective_youngs_modulus_pa;
                 let kn = 4.0 / 3.0 * e_star * contact_radius;
                 let sn = 2.0 * e_star * contact_radius;
-                let gamma_n = 2.0 * SQRT_FIVE_SIXTHS * damping_beta(restitution) * (sn * effective_mass_kg).sqrt();
+                let gamma_n = 2.0 * SQRT_FIVE_SIXTHS * mat.viscoelastic_beta * (sn * effective_mass_kg).sqrt();
                 NormalOutput {
                     force_n: kn * overlap_m - gamma_n * normal_velocity_m_per_s,
                     contact_radius_m: contact_radius,
+                    viscoelastic_damping_kg_per_s: gamma_n,
                 }
             }
             NormalModel::Thornton { plastic_slope } => NormalOutput {
@@ -102,6 +106,7 @@ impl NormalModel {
                     hist,
                 ),
                 contact_radius_m: (effective_radius_m * overlap_m).sqrt(),
+                viscoelastic_damping_kg_per_s: 0.0,
             },
         }
     }
@@ -228,6 +233,8 @@ mod tests {
             friction_coefficient: 0.3,
             yield_force_n: 0.5,
             rolling_friction_coefficient: 0.0,
+            viscoelastic_beta: 0.0,
+            tangential_damping_ratio: 1.0,
         }
     }
 

@@ -3,6 +3,8 @@
 //! Geometric mixing (R*, m*) depends on the two particles, not their species, and is done per contact in
 //! `forces.rs`. Walls are species too: a particle–wall pair uses the (particle species, wall species) entry.
 
+use super::contact_law::ContactLaw;
+use super::normal::{NormalModel, damping_beta};
 use crate::engine::particles::{SpeciesId, SpeciesTable};
 
 /// Mixed material properties of one species pair.
@@ -18,6 +20,11 @@ pub struct PairMaterial {
     pub yield_force_n: f64,
     /// Rolling-resistance coefficient μ_r of the pair.
     pub rolling_friction_coefficient: f64,
+    /// Hertz viscoelastic damping ratio β = |ln e| / √(ln² e + π²) of the contact law's restitution (0 for other
+    /// normal models). Precomputed: a logarithm per contact per step is a measurable share of the force loop.
+    pub viscoelastic_beta: f64,
+    /// √(4G*/E*) = √(k_t/S_n): Mindlin's tangential damping is the normal one times this (LIGGGHTS' γ_t/γ_n).
+    pub tangential_damping_ratio: f64,
 }
 
 /// Symmetric table of [`PairMaterial`]s, `n_species × n_species`.
@@ -28,7 +35,11 @@ pub struct PairTable {
 }
 
 impl PairTable {
-    pub fn new(species: &SpeciesTable) -> Self {
+    pub fn new(species: &SpeciesTable, law: &ContactLaw) -> Self {
+        let viscoelastic_beta = match law.normal {
+            NormalModel::Hertz { restitution } => damping_beta(restitution),
+            _ => 0.0,
+        };
         let n = species.len();
         let mut entries = Vec::with_capacity(n * n);
         for a in &species.species {
@@ -48,6 +59,8 @@ impl PairTable {
                 entries.push(PairMaterial {
                     effective_youngs_modulus_pa: 1.0 / inv_e,
                     effective_shear_modulus_pa: 1.0 / inv_g,
+                    viscoelastic_beta,
+                    tangential_damping_ratio: (4.0 * inv_e / inv_g).sqrt(),
                     friction_coefficient: 0.5 * (a.friction_coefficient + b.friction_coefficient),
                     yield_force_n,
                     rolling_friction_coefficient: 0.5

@@ -8,11 +8,9 @@
 use serde::{Deserialize, Serialize};
 
 use super::history::{ContactHistory, rotate_into_tangent_plane};
-use super::normal::{NormalModel, NormalOutput, damping_beta};
+use super::normal::NormalOutput;
 use super::pair_table::PairMaterial;
 use crate::engine::Vec3;
-
-const SQRT_FIVE_SIXTHS: f64 = 0.912_870_929_175_276_8;
 
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case", deny_unknown_fields)]
@@ -50,12 +48,10 @@ impl TangentialModel {
     /// Tangential force on i. `tangential_velocity` is the relative velocity of i's contact point with respect to
     /// j's, projected on the tangent plane (normal `n`).
     #[allow(clippy::too_many_arguments)]
-    #[inline]
+    #[inline(always)]
     pub fn force(
         &self,
-        normal_model: &NormalModel,
         mat: &PairMaterial,
-        effective_mass_kg: f64,
         normal: &NormalOutput,
         n: &Vec3,
         tangential_velocity: &Vec3,
@@ -81,11 +77,8 @@ impl TangentialModel {
             ),
             TangentialModel::Mindlin => {
                 let kt = 8.0 * mat.effective_shear_modulus_pa * normal.contact_radius_m;
-                let beta = match *normal_model {
-                    NormalModel::Hertz { restitution } => damping_beta(restitution),
-                    _ => 0.0,
-                };
-                let gamma_t = 2.0 * SQRT_FIVE_SIXTHS * beta * (kt * effective_mass_kg).sqrt();
+                // γ_t = 2√(5/6) β √(k_t m*) = γ_n √(k_t/S_n) (LIGGGHTS), with √(k_t/S_n) = √(4G*/E*) per pair.
+                let gamma_t = normal.viscoelastic_damping_kg_per_s * mat.tangential_damping_ratio;
                 spring_with_coulomb_limit(kt, gamma_t, limit, n, tangential_velocity, dt_s, hist)
             }
             TangentialModel::WaltonBraun { exponent } => {
@@ -186,6 +179,8 @@ mod tests {
             friction_coefficient: 0.5,
             yield_force_n: f64::INFINITY,
             rolling_friction_coefficient: 0.0,
+            viscoelastic_beta: 0.0,
+            tangential_damping_ratio: 1.0,
         }
     }
 
@@ -197,40 +192,19 @@ mod tests {
         let normal = NormalOutput {
             force_n: 2.0,
             contact_radius_m: 1e-5,
+            viscoelastic_damping_kg_per_s: 0.0,
         };
         let model = TangentialModel::WaltonBraun { exponent: 1.0 / 3.0 };
         let mut h = ContactHistory::default();
         let v = Vec3::new(-0.1, 0.0, 0.0); // pushes F_t towards +x
         let mut f = Vec3::zeros();
         for _ in 0..20000 {
-            f = model.force(
-                &NormalModel::Thornton {
-                    plastic_slope: Default::default(),
-                },
-                &mat(),
-                1e-6,
-                &normal,
-                &n,
-                &v,
-                1e-5,
-                &mut h,
-            );
+            f = model.force(&mat(), &normal, &n, &v, 1e-5, &mut h);
         }
         assert!((f.x - 1.0).abs() < 1e-9, "saturates at μF_n = 1: {f:?}");
         let before = f.x;
         let kt0 = 8.0 * 4e7 * 1e-5;
-        let f2 = model.force(
-            &NormalModel::Thornton {
-                plastic_slope: Default::default(),
-            },
-            &mat(),
-            1e-6,
-            &normal,
-            &n,
-            &(-v),
-            1e-5,
-            &mut h,
-        );
+        let f2 = model.force(&mat(), &normal, &n, &(-v), 1e-5, &mut h);
         let slope = (before - f2.x) / (0.1 * 1e-5);
         assert!(
             (slope - kt0).abs() < 1e-6 * kt0,
@@ -244,6 +218,7 @@ mod tests {
         let normal = NormalOutput {
             force_n: 1.0,
             contact_radius_m: 0.0,
+            viscoelastic_damping_kg_per_s: 0.0,
         };
         let model = TangentialModel::LinearSpringCoulomb {
             stiffness_n_per_m: 1000.0,
@@ -253,19 +228,7 @@ mod tests {
         let v = Vec3::new(0.0, 1.0, 0.0);
         let mut f = Vec3::zeros();
         for _ in 0..1000 {
-            f = model.force(
-                &NormalModel::LinearSpringDashpot {
-                    stiffness_n_per_m: 1.0,
-                    damping_kg_per_s: 0.0,
-                },
-                &mat(),
-                1.0,
-                &normal,
-                &n,
-                &v,
-                1e-4,
-                &mut h,
-            );
+            f = model.force(&mat(), &normal, &n, &v, 1e-4, &mut h);
         }
         assert!((f.norm() - 0.5).abs() < 1e-12);
         assert!(f.y < 0.0);
