@@ -39,6 +39,9 @@ pub struct Summary {
     pub bed_top_m: f64,
     pub mean_height_m: f64,
     pub wall_time_s: f64,
+    /// Time spent writing checkpoints in this invocation (included in wall_time_s).
+    pub checkpoint_time_s: f64,
+    pub checkpoints_written: u64,
     pub steps_per_s: f64,
     pub resumed_from_step: Option<u64>,
 }
@@ -198,6 +201,15 @@ pub fn simulate(opts: &SimulateOptions) -> Result<Summary> {
         );
     }
     let every = |n: u64, k: u64| (n / k + 1) * k;
+    let mut checkpoint_time_s = 0.0;
+    let mut checkpoints_written = 0u64;
+    let mut write_checkpoint = |sim: &Simulation| -> Result<()> {
+        let t = Instant::now();
+        series.write(&sim.snapshot(), &meta)?;
+        checkpoint_time_s += t.elapsed().as_secs_f64();
+        checkpoints_written += 1;
+        Ok(())
+    };
     while sim.step < stop_at {
         let next = every(sim.step, built.spec.output.series_every_steps)
             .min(every(sim.step, built.spec.output.checkpoint_every_steps))
@@ -208,7 +220,7 @@ pub fn simulate(opts: &SimulateOptions) -> Result<Summary> {
         }
         if sim.step % built.spec.output.checkpoint_every_steps == 0 || sim.step == total_steps {
             series_file.flush().map_err(|e| Error::io("write", &series_path, e))?;
-            series.write(&sim.snapshot(), &meta)?;
+            write_checkpoint(&sim)?;
         }
         if !opts.quiet && last_report.elapsed().as_secs_f64() > 5.0 {
             last_report = Instant::now();
@@ -226,7 +238,7 @@ pub fn simulate(opts: &SimulateOptions) -> Result<Summary> {
     if sim.step % built.spec.output.checkpoint_every_steps != 0 && sim.step != total_steps {
         // Stopped early (--max-steps): keep everything computed so far.
         series_file.flush().map_err(|e| Error::io("write", &series_path, e))?;
-        series.write(&sim.snapshot(), &meta)?;
+        write_checkpoint(&sim)?;
     }
     let wall = start.elapsed().as_secs_f64();
     let (top, mean) = sim.bed_height_m();
@@ -242,6 +254,8 @@ pub fn simulate(opts: &SimulateOptions) -> Result<Summary> {
         bed_top_m: top,
         mean_height_m: mean,
         wall_time_s: wall,
+        checkpoint_time_s,
+        checkpoints_written,
         steps_per_s: (sim.step - start_step) as f64 / wall.max(1e-9),
         resumed_from_step,
     };
