@@ -199,6 +199,48 @@ impl ColumnsMut<'_> {
         h
     }
 
+    /// [`ColumnsMut::load`] with the layout known at compile time (`WB`: Walton-Braun columns, `TH`: Thornton
+    /// columns), so that the fields a law does not use never touch memory. Must match the view's layout.
+    #[inline(always)]
+    pub fn load_as<const WB: bool, const TH: bool>(&self, k: usize) -> ContactHistory {
+        debug_assert!(self.layout.walton_braun == WB && self.layout.thornton == TH);
+        let mut h = ContactHistory {
+            active: self.touching[k],
+            tangential: self.tangential[k],
+            ..ContactHistory::INACTIVE
+        };
+        if WB {
+            h.reversal_force_n = self.reversal[k];
+            h.increment_direction = self.direction[k];
+        }
+        if TH {
+            let t = self.thornton[k];
+            h.max_overlap_m = t.max_overlap_m;
+            h.max_normal_force_n = t.max_normal_force_n;
+            h.yielded = t.yielded;
+        }
+        h
+    }
+
+    /// [`ColumnsMut::save`] with the layout known at compile time.
+    #[inline(always)]
+    pub fn save_as<const WB: bool, const TH: bool>(&mut self, k: usize, h: &ContactHistory) {
+        debug_assert!(self.layout.walton_braun == WB && self.layout.thornton == TH);
+        self.touching[k] = h.active;
+        self.tangential[k] = h.tangential;
+        if WB {
+            self.reversal[k] = h.reversal_force_n;
+            self.direction[k] = h.increment_direction;
+        }
+        if TH {
+            self.thornton[k] = ThorntonState {
+                max_overlap_m: h.max_overlap_m,
+                max_normal_force_n: h.max_normal_force_n,
+                yielded: h.yielded,
+            };
+        }
+    }
+
     #[inline(always)]
     pub fn save(&mut self, k: usize, h: &ContactHistory) {
         self.touching[k] = h.active;

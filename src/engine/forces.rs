@@ -162,7 +162,7 @@ struct PairResult {
 impl Context<'_> {
     /// Evaluates the pair (i, j) in local history slot `k` if it overlaps; otherwise releases the slot.
     #[inline(always)]
-    fn pair(
+    fn pair<const WB: bool, const TH: bool>(
         &self,
         i: usize,
         j: usize,
@@ -195,9 +195,9 @@ impl Context<'_> {
             relative_angular_velocity: wi - wj,
         };
         let mat = self.table.get(p.species[i], p.species[j]);
-        let mut h = hist.load(k);
+        let mut h = hist.load_as::<WB, TH>(k);
         let out = self.law.evaluate(mat, &kin, self.dt_s, &mut h);
-        hist.save(k, &h);
+        hist.save_as::<WB, TH>(k, &h);
         let nxft = n.cross(&out.tangential_force);
         Some(PairResult {
             force: out.force,
@@ -210,7 +210,7 @@ impl Context<'_> {
     /// order; `hist` holds exactly i's wall slots.
     #[allow(clippy::too_many_arguments)]
     #[inline(always)]
-    fn walls(
+    fn walls<const WB: bool, const TH: bool>(
         &self,
         i: usize,
         vi: Vec3,
@@ -245,9 +245,9 @@ impl Context<'_> {
                 relative_angular_velocity: wi - prox.wall_angular_velocity,
             };
             let mat = self.table.get(p.species[i], wall.species);
-            let mut h = hist.load(k);
+            let mut h = hist.load_as::<WB, TH>(k);
             let out = self.law.evaluate(mat, &kin, self.dt_s, &mut h);
-            hist.save(k, &h);
+            hist.save_as::<WB, TH>(k, &h);
             *f += out.force;
             *t += -(n.cross(&out.tangential_force) * ri) + out.rolling_torque;
         }
@@ -294,6 +294,18 @@ fn finite(v: &Vec3) -> bool {
     (v.x + v.y + v.z).is_finite()
 }
 
+/// The first index (offset by `base`) whose velocity or angular velocity is not finite, looked for only when
+/// `sum` (of all their components) is not finite.
+fn first_non_finite(sum: f64, v: &[Vec3], w: &[Vec3], base: usize) -> Option<usize> {
+    if sum.is_finite() {
+        return None;
+    }
+    v.iter()
+        .zip(w)
+        .position(|(v, w)| !(finite(v) && finite(w)))
+        .map(|k| base + k)
+}
+
 /// What the force pass reports.
 #[derive(Debug, Clone, Copy)]
 pub struct ForcePass {
@@ -331,19 +343,23 @@ pub fn compute_contact_forces(
         dt_s,
         kick,
     };
-    let pass = if threads <= 1 {
-        serial(&ctx, list, history, &mut force, &mut torque, &mut velocity, &mut omega)
-    } else {
-        parallel(
-            &ctx,
-            list,
-            history,
-            buffers,
-            &mut force,
-            &mut torque,
-            &mut velocity,
-            &mut omega,
-        )
+    // One instantiation per history layout: the layout decides which history fields exist, and knowing it at
+    // compile time lets the kernels' unused fields vanish from the loop.
+    let layout = config.contact_law.history_layout();
+    macro_rules! run {
+        ($wb:literal, $th:literal) => {
+            if threads <= 1 {
+                serial::<$wb, $th>(&ctx, list, history, &mut force, &mut torque, &mut velocity, &mut omega)
+            } else {
+                parallel::<$wb, $th>(&ctx, list, history, buffers, &mut force, &mut torque, &mut velocity, &mut omega)
+            }
+        };
+    }
+    let pass = match (layout.walton_braun, layout.thornton) {
+        (false, false) => run!(false, false),
+        (true, false) => run!(true, false),
+        (false, true) => run!(false, true),
+        (true, true) => run!(true, true),
     };
     p.force_n = force;
     p.torque_n_m = torque;
@@ -352,7 +368,7 @@ pub fn compute_contact_forces(
     pass
 }
 
-fn serial(
+fn serial<const WB: bool, const TH: bool>(
     ctx: &Context,
     list: &NeighborList,
     history: &mut AlignedHistory,
@@ -363,7 +379,8 @@ fn serial(
 ) -> ForcePass {
     let n = ctx.p.len();
     let mut worst = WorstOverlap::NONE;
-    let mut non_finite = None;
+    // A NaN or infinity in any kicked velocity propagates into this sum; the culprit is looked for only then.
+    let mut velocity_sum = 0.0f64;
     force.fill(Vec3::zeros());
     torque.fill(Vec3::zeros());
     let vel = Cells {
@@ -376,7 +393,7 @@ fn serial(
         let slots = list.pairs_of(i);
         for (k, &j) in slots.clone().zip(&list.partner[slots]) {
             let j = j as usize;
-            if let Some(r) = ctx.pair(i, j, &vel, &mut pairs, k, &mut worst) {
+            if let Some(r) = ctx.pair::<WB, TH>(i, j, &vel, &mut pairs, k, &mut worst) {
                 force[i] += r.force;
                 force[j] -= r.force;
                 torque[i] += r.torque_i;
@@ -386,7 +403,7 @@ fn serial(
         let wall_slots = list.walls_of(i);
         let (mut f, mut t) = (force[i], torque[i]);
         let (vi, wi) = (vel.v(i), vel.w(i));
-        ctx.walls(
+        ctx.walls::<WB, TH>(
             i,
             vi,
             wi,
@@ -398,9 +415,7 @@ fn serial(
             &mut worst,
         );
         let (v_new, w_new) = ctx.finish(i, &mut f, &mut t, vi, wi);
-        if non_finite.is_none() && !(finite(&v_new) && finite(&w_new)) {
-            non_finite = Some(i);
-        }
+        velocity_sum += (v_new.x + v_new.y + v_new.z) + (w_new.x + w_new.y + w_new.z);
         vel.v[i].set(v_new);
         vel.w[i].set(w_new);
         force[i] = f;
@@ -408,7 +423,7 @@ fn serial(
     }
     ForcePass {
         worst_overlap: worst,
-        non_finite,
+        non_finite: first_non_finite(velocity_sum, velocity, omega, 0),
     }
 }
 
@@ -426,7 +441,7 @@ fn split_by_offsets<'a, T>(mut data: &'a mut [T], ends: &[usize]) -> Vec<&'a mut
 }
 
 #[allow(clippy::too_many_arguments)]
-fn parallel(
+fn parallel<const WB: bool, const TH: bool>(
     ctx: &Context,
     list: &NeighborList,
     history: &mut AlignedHistory,
@@ -464,7 +479,7 @@ fn parallel(
                 for k in list.pairs_of(i) {
                     let j = list.partner[k] as usize;
                     let local = k - base;
-                    if let Some(r) = ctx.pair(i, j, &vel, &mut hist, local, &mut worst) {
+                    if let Some(r) = ctx.pair::<WB, TH>(i, j, &vel, &mut hist, local, &mut worst) {
                         fb[local] = r.force;
                         tib[local] = r.torque_i;
                         tjb[local] = r.torque_j;
@@ -489,7 +504,7 @@ fn parallel(
             let lo = c * CHUNK;
             let wall_base = list.wall_start[lo] as usize;
             let mut worst = WorstOverlap::NONE;
-            let mut non_finite = None;
+            let mut velocity_sum = 0.0f64;
             for offset in 0..fc.len() {
                 let p = lo + offset;
                 let mut f = Vec3::zeros();
@@ -510,7 +525,7 @@ fn parallel(
                 }
                 let walls = list.walls_of(p);
                 let (vi, wi) = (vc[offset], wc[offset]);
-                ctx.walls(
+                ctx.walls::<WB, TH>(
                     p,
                     vi,
                     wi,
@@ -522,15 +537,13 @@ fn parallel(
                     &mut worst,
                 );
                 let (v_new, w_new) = ctx.finish(p, &mut f, &mut t, vi, wi);
-                if non_finite.is_none() && !(finite(&v_new) && finite(&w_new)) {
-                    non_finite = Some(p);
-                }
+                velocity_sum += (v_new.x + v_new.y + v_new.z) + (w_new.x + w_new.y + w_new.z);
                 vc[offset] = v_new;
                 wc[offset] = w_new;
                 fc[offset] = f;
                 tc[offset] = t;
             }
-            (worst, non_finite)
+            (worst, first_non_finite(velocity_sum, vc, wc, lo))
         })
         .reduce(
             || (WorstOverlap::NONE, None),
