@@ -27,3 +27,54 @@ fill (list of):
   random: { species, count, lo_m, hi_m, inside_drum? }
 time: { end_time_s, dt_s | dt_fraction_of_contact_time, reference_velocity_m_per_s? }
 "#;
+
+#[cfg(test)]
+mod tests {
+    use super::MODELS;
+    use crate::engine::models::{ContactLaw, NormalModel, PlasticSlope, RollingModel, TangentialModel};
+
+    /// Every model the enums define is listed, under the name the YAML and checkpoints use, and the listed forms
+    /// parse.
+    #[test]
+    fn every_model_is_listed_and_its_form_parses() {
+        let normals = [
+            NormalModel::LinearSpringDashpot {
+                stiffness_n_per_m: 800.0,
+                damping_kg_per_s: 1e-3,
+            },
+            NormalModel::Hertz { restitution: 0.9 },
+            NormalModel::Thornton {
+                plastic_slope: PlasticSlope::Continuous,
+            },
+        ];
+        let tangentials = [
+            TangentialModel::LinearSpringCoulomb {
+                stiffness_n_per_m: 800.0,
+                damping_kg_per_s: 1e-3,
+            },
+            TangentialModel::Mindlin,
+            TangentialModel::WaltonBraun { exponent: 1.0 / 3.0 },
+        ];
+        let rollings = [RollingModel::None, RollingModel::ConstantDirectionalTorque];
+        for name in normals
+            .iter()
+            .map(|m| m.name())
+            .chain(tangentials.iter().map(|m| m.name()))
+            .chain(rollings.iter().map(|m| m.name()))
+        {
+            assert!(MODELS.contains(name), "`granflow models` does not list {name}");
+        }
+        for yaml in [
+            "{ normal: { linear_spring_dashpot: { stiffness_n_per_m: 800.0, damping_kg_per_s: 0.001 } }, tangential: { linear_spring_coulomb: { stiffness_n_per_m: 800.0, damping_kg_per_s: 0.001 } } }",
+            "{ normal: { hertz: { restitution: 0.9 } }, tangential: mindlin, rolling: constant_directional_torque }",
+            "{ normal: { thornton: { plastic_slope: seed_printed } }, tangential: { walton_braun: { exponent: 0.5 } }, rolling: none }",
+        ] {
+            let de = serde_norway::Deserializer::from_str(yaml);
+            let law: ContactLaw =
+                serde_norway::with::singleton_map_recursive::deserialize(de).unwrap_or_else(|e| panic!("{yaml}: {e}"));
+            for name in law.model_names() {
+                assert!(MODELS.contains(name));
+            }
+        }
+    }
+}

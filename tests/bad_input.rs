@@ -22,22 +22,102 @@ time: { dt_s: 1.0e-5, end_time_s: 0.001 }
 /// (case, text replaced in GOOD, replacement, fragments the message must contain)
 const CASES: &[(&str, &str, &str, &[&str])] = &[
     ("yaml syntax error", "gravity: {", "gravity: {{", &["bad.yaml:", "line"]),
-    ("unknown key", "radius_m: 0.001", "radius: 0.001", &["bad.yaml:", "unknown field `radius`", "radius_m"]),
-    ("wrong type", "restitution: 0.9", "restitution: high", &["bad.yaml:", "invalid type"]),
-    ("missing required field", "time: { dt_s: 1.0e-5, end_time_s: 0.001 }", "time: { dt_s: 1.0e-5 }", &["missing field `end_time_s`"]),
-    ("negative radius", "radius_m: 0.001", "radius_m: -0.001", &["species[0].radius_m", "> 0"]),
-    ("zero density", "density_kg_per_m3: 2500.0", "density_kg_per_m3: 0.0", &["species[0].density_kg_per_m3"]),
-    ("NaN modulus", "youngs_modulus_pa: 1.0e7", "youngs_modulus_pa: .nan", &["species[0].youngs_modulus_pa"]),
-    ("Poisson ratio too large", "poisson_ratio: 0.3", "poisson_ratio: 0.6", &["species[0].poisson_ratio"]),
-    ("restitution above one", "restitution: 0.9", "restitution: 1.5", &["contact.normal.hertz.restitution"]),
-    ("unknown contact model", "tangential: mindlin", "tangential: mindlyn", &["bad.yaml:", "mindlyn"]),
-    ("mindlin with linear normal", "normal: { hertz: { restitution: 0.9 } }", "normal: { linear_spring_dashpot: { stiffness_n_per_m: 800.0, damping_kg_per_s: 0.001 } }", &["contact.tangential", "Hertzian"]),
-    ("unknown species in wall", "box: { species: glass }", "box: { species: steel }", &["walls[0].box.species", "steel"]),
-    ("inverted domain", "hi_m: [0.02, 0.02, 0.05]", "hi_m: [0.02, -0.02, 0.05]", &["domain.hi_m[1]"]),
-    ("lattice spacing below diameter", "spacing_m: 0.0025", "spacing_m: 0.0015", &["fill[0].lattice.spacing_m", "diameter"]),
-    ("particles cannot fit", "lo_m: [0.001, 0.001, 0.001], hi_m: [0.019, 0.019, 0.02]", "lo_m: [0.03, 0.03, 0.03], hi_m: [0.04, 0.04, 0.04]", &["fill[0].lattice", "no particle fits"]),
-    ("both time steps", "dt_s: 1.0e-5,", "dt_s: 1.0e-5, dt_fraction_of_contact_time: 0.02,", &["time", "exactly one"]),
-    ("zero end time", "end_time_s: 0.001", "end_time_s: 0.0", &["time.end_time_s"]),
+    (
+        "unknown key",
+        "radius_m: 0.001",
+        "radius: 0.001",
+        &["bad.yaml:", "unknown field `radius`", "radius_m"],
+    ),
+    (
+        "wrong type",
+        "restitution: 0.9",
+        "restitution: high",
+        &["bad.yaml:", "invalid type"],
+    ),
+    (
+        "missing required field",
+        "time: { dt_s: 1.0e-5, end_time_s: 0.001 }",
+        "time: { dt_s: 1.0e-5 }",
+        &["missing field `end_time_s`"],
+    ),
+    (
+        "negative radius",
+        "radius_m: 0.001",
+        "radius_m: -0.001",
+        &["species[0].radius_m", "> 0"],
+    ),
+    (
+        "zero density",
+        "density_kg_per_m3: 2500.0",
+        "density_kg_per_m3: 0.0",
+        &["species[0].density_kg_per_m3"],
+    ),
+    (
+        "NaN modulus",
+        "youngs_modulus_pa: 1.0e7",
+        "youngs_modulus_pa: .nan",
+        &["species[0].youngs_modulus_pa"],
+    ),
+    (
+        "Poisson ratio too large",
+        "poisson_ratio: 0.3",
+        "poisson_ratio: 0.6",
+        &["species[0].poisson_ratio"],
+    ),
+    (
+        "restitution above one",
+        "restitution: 0.9",
+        "restitution: 1.5",
+        &["contact.normal.hertz.restitution"],
+    ),
+    (
+        "unknown contact model",
+        "tangential: mindlin",
+        "tangential: mindlyn",
+        &["bad.yaml:", "mindlyn"],
+    ),
+    (
+        "mindlin with linear normal",
+        "normal: { hertz: { restitution: 0.9 } }",
+        "normal: { linear_spring_dashpot: { stiffness_n_per_m: 800.0, damping_kg_per_s: 0.001 } }",
+        &["contact.tangential", "Hertzian"],
+    ),
+    (
+        "unknown species in wall",
+        "box: { species: glass }",
+        "box: { species: steel }",
+        &["walls[0].box.species", "steel"],
+    ),
+    (
+        "inverted domain",
+        "hi_m: [0.02, 0.02, 0.05]",
+        "hi_m: [0.02, -0.02, 0.05]",
+        &["domain.hi_m[1]"],
+    ),
+    (
+        "lattice spacing below diameter",
+        "spacing_m: 0.0025",
+        "spacing_m: 0.0015",
+        &["fill[0].lattice.spacing_m", "diameter"],
+    ),
+    (
+        "particles cannot fit",
+        "lo_m: [0.001, 0.001, 0.001], hi_m: [0.019, 0.019, 0.02]",
+        "lo_m: [0.03, 0.03, 0.03], hi_m: [0.04, 0.04, 0.04]",
+        &["fill[0].lattice", "no particle fits"],
+    ),
+    (
+        "both time steps",
+        "dt_s: 1.0e-5,",
+        "dt_s: 1.0e-5, dt_fraction_of_contact_time: 0.02,",
+        &["time", "exactly one"],
+    ),
+    (
+        "zero end time",
+        "end_time_s: 0.001",
+        "end_time_s: 0.0",
+        &["time.end_time_s"],
+    ),
 ];
 
 #[test]
@@ -50,7 +130,10 @@ fn bad_scenarios_fail_cleanly_before_writing_anything() {
     assert!(ok.status.success(), "{}", String::from_utf8_lossy(&ok.stderr));
 
     for (case, from, to, fragments) in CASES {
-        assert!(GOOD.contains(from), "case '{case}': '{from}' is not in the good scenario");
+        assert!(
+            GOOD.contains(from),
+            "case '{case}': '{from}' is not in the good scenario"
+        );
         std::fs::write(dir.join("bad.yaml"), GOOD.replacen(from, to, 1)).expect("write");
         let out = granflow(&["simulate", "bad.yaml", "--out", "bad-out"], dir);
         let stderr = String::from_utf8_lossy(&out.stderr);

@@ -16,8 +16,8 @@ use rayon::prelude::*;
 
 use super::Vec3;
 use super::contacts::{AlignedHistory, ColumnsMut};
-use super::integrate::{InverseInertia, half_kick_one};
 use super::geometry::Wall;
+use super::integrate::{InverseInertia, half_kick_one};
 use super::models::{ContactKinematics, ContactLaw, PairTable};
 use super::neighbor::NeighborList;
 use super::particles::{ParticleId, Particles};
@@ -349,9 +349,26 @@ pub fn compute_contact_forces(
     macro_rules! run {
         ($wb:literal, $th:literal) => {
             if threads <= 1 {
-                serial::<$wb, $th>(&ctx, list, history, &mut force, &mut torque, &mut velocity, &mut omega)
+                serial::<$wb, $th>(
+                    &ctx,
+                    list,
+                    history,
+                    &mut force,
+                    &mut torque,
+                    &mut velocity,
+                    &mut omega,
+                )
             } else {
-                parallel::<$wb, $th>(&ctx, list, history, buffers, &mut force, &mut torque, &mut velocity, &mut omega)
+                parallel::<$wb, $th>(
+                    &ctx,
+                    list,
+                    history,
+                    buffers,
+                    &mut force,
+                    &mut torque,
+                    &mut velocity,
+                    &mut omega,
+                )
             }
         };
     }

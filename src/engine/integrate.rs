@@ -80,8 +80,17 @@ pub fn kick_drift(
         .enumerate()
         .map(|(c, ((((x, v), w), (f, t)), (inv_m, inv_i)))| {
             let mut max_d2 = 0.0f64;
-            let reference = if check_displacement { &reference[c * CHUNK..c * CHUNK + x.len()] } else { &[] };
-            let particles = x.iter_mut().zip(v.iter_mut()).zip(w.iter_mut()).zip(f.iter().zip(t)).zip(inv_m.iter().zip(inv_i));
+            let reference = if check_displacement {
+                &reference[c * CHUNK..c * CHUNK + x.len()]
+            } else {
+                &[]
+            };
+            let particles = x
+                .iter_mut()
+                .zip(v.iter_mut())
+                .zip(w.iter_mut())
+                .zip(f.iter().zip(t))
+                .zip(inv_m.iter().zip(inv_i));
             for (k, ((((x, v), w), (f, t)), (&inv_m, &inv_i))) in particles.enumerate() {
                 half_kick_one(v, w, f, t, inv_m, inv_i, &g_half_dt, half_dt);
                 if pseudo_2d {

@@ -207,10 +207,12 @@ impl Simulation {
         self.step += 1;
         self.time_s += dt;
         let t1 = Instant::now();
-        if self
-            .list
-            .needs_rebuild(self.particles.len(), max_displacement2, &config.walls, &self.wall_angle_rad)
-        {
+        if self.list.needs_rebuild(
+            self.particles.len(),
+            max_displacement2,
+            &config.walls,
+            &self.wall_angle_rad,
+        ) {
             if let Some(i) = find_lost(&self.particles, &config.domain, self.particles.max_radius_m()) {
                 let position_m = self.particles.position_m[i];
                 return Err(if (position_m.x + position_m.y + position_m.z).is_finite() {
