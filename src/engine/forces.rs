@@ -2,9 +2,10 @@
 //!
 //! The order for particle p is: first its contacts as the *second* particle of a pair (ascending first particle),
 //! then as the first particle (ascending partner), then its walls (ascending wall index). On one thread the pair loop
-//! scatters directly (f_i += F, f_j −= F), which produces exactly that order; on several threads each pair's result
-//! is written to a per-slot buffer in parallel and then gathered per particle in that same order. Both paths run
-//! the same per-contact kernel, so one and N threads give bit-identical forces.
+//! scatters directly (f_i += F, f_j −= F), which produces exactly that order; on several threads each thread runs
+//! that same loop over its own contiguous range of particles, with the few pairs that cross a range boundary
+//! computed first and merged in the same order (see [`parallel`]). Both paths run the same per-contact kernel, so
+//! one and N threads give bit-identical forces.
 //!
 //! The second half kick of velocity Verlet is fused into this pass: a particle's force is complete when its own
 //! iteration ends (its contacts as second particle came earlier), and no later pair reads its velocity, so it is
@@ -23,21 +24,20 @@ use super::neighbor::NeighborList;
 use super::particles::{ParticleId, Particles};
 use super::simulation::SimConfig;
 
-/// Particles per parallel work item.
-const CHUNK: usize = 1024;
-
-/// Per-slot results of the pair pass (multi-threaded path only).
+/// Per-slot results of cross-range pairs (multi-threaded path only).
 #[derive(Debug, Default, Clone)]
 pub struct PairBuffers {
     force_on_i: Vec<Vec3>,
     torque_on_i: Vec<Vec3>,
     torque_on_j: Vec<Vec3>,
+    touching: Vec<bool>,
 }
 
 impl PairBuffers {
     pub fn heap_bytes(&self) -> usize {
         (self.force_on_i.capacity() + self.torque_on_i.capacity() + self.torque_on_j.capacity())
             * std::mem::size_of::<Vec3>()
+            + self.touching.capacity()
     }
 }
 
@@ -136,6 +136,24 @@ impl Velocities for Cells<'_> {
     #[inline(always)]
     fn w(&self, i: usize) -> Vec3 {
         self.w[i].get()
+    }
+}
+
+/// Cells over one range of particles, indexed by global particle index.
+struct RangeCells<'a> {
+    v: &'a [Cell<Vec3>],
+    w: &'a [Cell<Vec3>],
+    base: usize,
+}
+
+impl Velocities for RangeCells<'_> {
+    #[inline(always)]
+    fn v(&self, i: usize) -> Vec3 {
+        self.v[i - self.base].get()
+    }
+    #[inline(always)]
+    fn w(&self, i: usize) -> Vec3 {
+        self.w[i - self.base].get()
     }
 }
 
@@ -368,6 +386,7 @@ pub fn compute_contact_forces(
                     &mut torque,
                     &mut velocity,
                     &mut omega,
+                    threads,
                 )
             }
         };
@@ -457,6 +476,13 @@ fn split_by_offsets<'a, T>(mut data: &'a mut [T], ends: &[usize]) -> Vec<&'a mut
     out
 }
 
+/// Several threads: the particles are cut into one contiguous range per thread.
+///
+/// Phase A computes, in parallel, only the pairs whose partner lies in a later range (the pairs two ranges share),
+/// into per-slot buffers. Phase B runs, in parallel, the serial loop over each range: each particle first receives
+/// its contributions from earlier ranges (ascending first particle, from the buffers), then the range is processed
+/// exactly as the serial loop does, taking the buffered results for its cross-range pairs. Every particle's sum is
+/// thus formed in the serial order, and only a boundary layer of pairs goes through memory twice.
 #[allow(clippy::too_many_arguments)]
 fn parallel<const WB: bool, const TH: bool>(
     ctx: &Context,
@@ -467,98 +493,138 @@ fn parallel<const WB: bool, const TH: bool>(
     torque: &mut [Vec3],
     velocity: &mut [Vec3],
     omega: &mut [Vec3],
+    threads: usize,
 ) -> ForcePass {
     let n = ctx.p.len();
+    let ranges = threads.clamp(1, n.max(1));
+    let bounds: Vec<usize> = (0..=ranges).map(|r| r * n / ranges).collect();
+    let particle_ends = &bounds[1..];
+    let pair_ends: Vec<usize> = particle_ends.iter().map(|&b| list.start[b] as usize).collect();
+    let wall_ends: Vec<usize> = particle_ends.iter().map(|&b| list.wall_start[b] as usize).collect();
     let n_slots = list.pair_count();
     buffers.force_on_i.resize(n_slots, Vec3::zeros());
     buffers.torque_on_i.resize(n_slots, Vec3::zeros());
     buffers.torque_on_j.resize(n_slots, Vec3::zeros());
-    let chunk_bounds: Vec<usize> = (1..=n.div_ceil(CHUNK)).map(|c| (c * CHUNK).min(n)).collect();
+    buffers.touching.resize(n_slots, false);
 
-    // Pass 1: every pair slot, in parallel by chunks of first particles; velocities are only read.
-    let pair_ends: Vec<usize> = chunk_bounds.iter().map(|&hi| list.start[hi] as usize).collect();
+    // Phase A: cross-range pairs, velocities only read.
+    let worst_cross = {
+        let hist_parts = history.pair.split(&pair_ends);
+        let f_parts = split_by_offsets(&mut buffers.force_on_i, &pair_ends);
+        let ti_parts = split_by_offsets(&mut buffers.torque_on_i, &pair_ends);
+        let tj_parts = split_by_offsets(&mut buffers.torque_on_j, &pair_ends);
+        let on_parts = split_by_offsets(&mut buffers.touching, &pair_ends);
+        let vel = Plain { v: velocity, w: omega };
+        hist_parts
+            .into_par_iter()
+            .zip(f_parts)
+            .zip(ti_parts.into_par_iter().zip(tj_parts.into_par_iter().zip(on_parts)))
+            .enumerate()
+            .map(|(r, ((mut hist, fb), (tib, (tjb, onb))))| {
+                let (lo, hi) = (bounds[r], bounds[r + 1]);
+                let base = list.start[lo] as usize;
+                let mut worst = WorstOverlap::NONE;
+                for i in lo..hi {
+                    for k in list.pairs_of(i) {
+                        let j = list.partner[k] as usize;
+                        if j < hi {
+                            continue;
+                        }
+                        let local = k - base;
+                        match ctx.pair::<WB, TH>(i, j, &vel, &mut hist, local, &mut worst) {
+                            Some(res) => {
+                                fb[local] = res.force;
+                                tib[local] = res.torque_i;
+                                tjb[local] = res.torque_j;
+                                onb[local] = true;
+                            }
+                            None => onb[local] = false,
+                        }
+                    }
+                }
+                worst
+            })
+            .reduce(|| WorstOverlap::NONE, WorstOverlap::max)
+    };
+
+    // Phase B: each range in the serial order.
+    let buffers = &*buffers;
     let hist_parts = history.pair.split(&pair_ends);
-    let f_parts = split_by_offsets(&mut buffers.force_on_i, &pair_ends);
-    let ti_parts = split_by_offsets(&mut buffers.torque_on_i, &pair_ends);
-    let tj_parts = split_by_offsets(&mut buffers.torque_on_j, &pair_ends);
-    let vel = Plain { v: velocity, w: omega };
-    let worst_pairs = hist_parts
+    let wall_parts = history.wall.split(&wall_ends);
+    let f_parts = split_by_offsets(force, particle_ends);
+    let t_parts = split_by_offsets(torque, particle_ends);
+    let v_parts = split_by_offsets(velocity, particle_ends);
+    let w_parts = split_by_offsets(omega, particle_ends);
+    let (worst_ranges, non_finite) = f_parts
         .into_par_iter()
-        .zip(f_parts)
-        .zip(ti_parts.into_par_iter().zip(tj_parts))
+        .zip(t_parts)
+        .zip(v_parts.into_par_iter().zip(w_parts))
+        .zip(hist_parts.into_par_iter().zip(wall_parts))
         .enumerate()
-        .map(|(c, ((mut hist, fb), (tib, tjb)))| {
-            let lo = c * CHUNK;
-            let hi = chunk_bounds[c];
-            let base = list.start[lo] as usize;
+        .map(|(r, (((fc, tc), (vc, wc)), (mut pairs, mut walls)))| {
+            let (lo, hi) = (bounds[r], bounds[r + 1]);
+            let pair_base = list.start[lo] as usize;
+            let wall_base = list.wall_start[lo] as usize;
             let mut worst = WorstOverlap::NONE;
-            for i in lo..hi {
-                for k in list.pairs_of(i) {
-                    let j = list.partner[k] as usize;
-                    let local = k - base;
-                    if let Some(r) = ctx.pair::<WB, TH>(i, j, &vel, &mut hist, local, &mut worst) {
-                        fb[local] = r.force;
-                        tib[local] = r.torque_i;
-                        tjb[local] = r.torque_j;
+            // Contributions from earlier ranges come first in the serial order (ascending first particle).
+            for (local, (f, t)) in fc.iter_mut().zip(tc.iter_mut()).enumerate() {
+                *f = Vec3::zeros();
+                *t = Vec3::zeros();
+                let p = lo + local;
+                let entries = list.reverse_start[p] as usize..list.reverse_start[p + 1] as usize;
+                for e in entries {
+                    if list.reverse_first[e] as usize >= lo {
+                        break;
+                    }
+                    let slot = list.reverse_slot[e] as usize;
+                    if buffers.touching[slot] {
+                        *f -= buffers.force_on_i[slot];
+                        *t += buffers.torque_on_j[slot];
                     }
                 }
             }
-            worst
-        })
-        .reduce(|| WorstOverlap::NONE, WorstOverlap::max);
-
-    // Pass 2: gather per particle in the serial order, then walls, then the kick.
-    let pair_touching = &history.pair.touching;
-    let wall_ends: Vec<usize> = chunk_bounds.iter().map(|&hi| list.wall_start[hi] as usize).collect();
-    let wall_parts = history.wall.split(&wall_ends);
-    let (worst_walls, non_finite) = force
-        .par_chunks_mut(CHUNK)
-        .zip(torque.par_chunks_mut(CHUNK))
-        .zip(velocity.par_chunks_mut(CHUNK).zip(omega.par_chunks_mut(CHUNK)))
-        .zip(wall_parts)
-        .enumerate()
-        .map(|(c, (((fc, tc), (vc, wc)), mut wall_hist))| {
-            let lo = c * CHUNK;
-            let wall_base = list.wall_start[lo] as usize;
-            let mut worst = WorstOverlap::NONE;
+            let vel = RangeCells {
+                v: Cell::from_mut(vc).as_slice_of_cells(),
+                w: Cell::from_mut(wc).as_slice_of_cells(),
+                base: lo,
+            };
             let mut velocity_sum = 0.0f64;
-            for offset in 0..fc.len() {
-                let p = lo + offset;
-                let mut f = Vec3::zeros();
-                let mut t = Vec3::zeros();
-                let rev = list.reverse_start[p] as usize..list.reverse_start[p + 1] as usize;
-                for &slot in &list.reverse_slot[rev] {
-                    let slot = slot as usize;
-                    if pair_touching[slot] {
-                        f -= buffers.force_on_i[slot];
-                        t += buffers.torque_on_j[slot];
+            for i in lo..hi {
+                let slots = list.pairs_of(i);
+                for (k, &j) in slots.clone().zip(&list.partner[slots]) {
+                    let j = j as usize;
+                    if j < hi {
+                        if let Some(res) = ctx.pair::<WB, TH>(i, j, &vel, &mut pairs, k - pair_base, &mut worst) {
+                            fc[i - lo] += res.force;
+                            fc[j - lo] -= res.force;
+                            tc[i - lo] += res.torque_i;
+                            tc[j - lo] += res.torque_j;
+                        }
+                    } else if buffers.touching[k] {
+                        fc[i - lo] += buffers.force_on_i[k];
+                        tc[i - lo] += buffers.torque_on_i[k];
                     }
                 }
-                for k in list.pairs_of(p) {
-                    if pair_touching[k] {
-                        f += buffers.force_on_i[k];
-                        t += buffers.torque_on_i[k];
-                    }
-                }
-                let walls = list.walls_of(p);
-                let (vi, wi) = (vc[offset], wc[offset]);
+                let wall_slots = list.walls_of(i);
+                let (mut f, mut t) = (fc[i - lo], tc[i - lo]);
+                let (vi, wi) = (vel.v(i), vel.w(i));
                 ctx.walls::<WB, TH>(
-                    p,
+                    i,
                     vi,
                     wi,
-                    &list.wall_partner[walls.clone()],
-                    &mut wall_hist,
-                    walls.start - wall_base,
+                    &list.wall_partner[wall_slots.clone()],
+                    &mut walls,
+                    wall_slots.start - wall_base,
                     &mut f,
                     &mut t,
                     &mut worst,
                 );
-                let (v_new, w_new) = ctx.finish(p, &mut f, &mut t, vi, wi);
+                let (v_new, w_new) = ctx.finish(i, &mut f, &mut t, vi, wi);
                 velocity_sum += (v_new.x + v_new.y + v_new.z) + (w_new.x + w_new.y + w_new.z);
-                vc[offset] = v_new;
-                wc[offset] = w_new;
-                fc[offset] = f;
-                tc[offset] = t;
+                vel.v[i - lo].set(v_new);
+                vel.w[i - lo].set(w_new);
+                fc[i - lo] = f;
+                tc[i - lo] = t;
             }
             (worst, first_non_finite(velocity_sum, vc, wc, lo))
         })
@@ -567,7 +633,7 @@ fn parallel<const WB: bool, const TH: bool>(
             |a, b| (a.0.max(b.0), a.1.min(b.1).or(a.1).or(b.1)),
         );
     ForcePass {
-        worst_overlap: worst_pairs.max(worst_walls),
+        worst_overlap: worst_cross.max(worst_ranges),
         non_finite,
     }
 }

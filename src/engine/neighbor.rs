@@ -24,6 +24,8 @@ pub struct NeighborList {
     pub reverse_start: Vec<u32>,
     /// Pair slot indices (into `partner`) grouped by partner, ascending in the first particle.
     pub reverse_slot: Vec<u32>,
+    /// The first particle of each `reverse_slot` entry.
+    pub reverse_first: Vec<u32>,
     pub wall_start: Vec<u32>,
     pub wall_partner: Vec<u16>,
     /// Positions and wall angles when the list was built.
@@ -207,10 +209,15 @@ impl NeighborList {
         let mut fill = self.reverse_start.clone();
         self.reverse_slot.clear();
         self.reverse_slot.resize(self.partner.len(), 0);
-        for (slot, &j) in self.partner.iter().enumerate() {
-            let f = &mut fill[j as usize];
-            self.reverse_slot[*f as usize] = slot as u32;
-            *f += 1;
+        self.reverse_first.clear();
+        self.reverse_first.resize(self.partner.len(), 0);
+        for i in 0..n {
+            for slot in self.pairs_of(i) {
+                let f = &mut fill[self.partner[slot] as usize];
+                self.reverse_slot[*f as usize] = slot as u32;
+                self.reverse_first[*f as usize] = i as u32;
+                *f += 1;
+            }
         }
 
         self.wall_start.clear();
@@ -240,6 +247,7 @@ impl NeighborList {
             + self.partner.capacity()
             + self.reverse_start.capacity()
             + self.reverse_slot.capacity()
+            + self.reverse_first.capacity()
             + self.wall_start.capacity())
             * 4
             + self.wall_partner.capacity() * 2
