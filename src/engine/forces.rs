@@ -344,7 +344,7 @@ pub fn compute_contact_forces(
     list: &NeighborList,
     history: &mut AlignedHistory,
     buffers: &mut PairBuffers,
-    threads: usize,
+    plan: &RangePlan,
     kick: Option<HalfKick>,
 ) -> ForcePass {
     let mut force = std::mem::take(&mut p.force_n);
@@ -366,7 +366,7 @@ pub fn compute_contact_forces(
     let layout = config.contact_law.history_layout();
     macro_rules! run {
         ($wb:literal, $th:literal) => {
-            if threads <= 1 {
+            if plan.bounds.len() <= 2 {
                 serial::<$wb, $th>(
                     &ctx,
                     list,
@@ -386,7 +386,7 @@ pub fn compute_contact_forces(
                     &mut torque,
                     &mut velocity,
                     &mut omega,
-                    threads,
+                    plan,
                 )
             }
         };
@@ -463,6 +463,67 @@ fn serial<const WB: bool, const TH: bool>(
     }
 }
 
+/// How the parallel pass cuts the particles: range bounds, and per range where its cross-range pairs start and
+/// where the contributions from earlier ranges end (so neither phase scans the whole range for them).
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct RangePlan {
+    /// `ranges + 1` bounds from 0 to n.
+    pub bounds: Vec<usize>,
+    /// Per range: the first particle with a partner beyond the range (the range end if none).
+    pub cross_from: Vec<usize>,
+    /// Per range: one past the last particle with a contact partner in an earlier range (the range start if none).
+    pub halo_to: Vec<usize>,
+}
+
+impl RangePlan {
+    /// Ranges balanced by estimated work: each particle costs 1 plus 4 per touching contact it owns (contacts
+    /// dominate). Any bounds give the same results; these only spread the work (a settling column has all its
+    /// contacts at the bottom at first).
+    pub fn balanced(list: &NeighborList, touching: &[bool], ranges: usize) -> RangePlan {
+        let n = list.start.len().saturating_sub(1);
+        let ranges = ranges.clamp(1, n.max(1));
+        let mut cumulative = Vec::with_capacity(n + 1);
+        let mut total = 0u64;
+        cumulative.push(0u64);
+        for i in 0..n {
+            let contacts = touching[list.pairs_of(i)].iter().filter(|&&t| t).count() as u64;
+            total += 1 + 4 * contacts;
+            cumulative.push(total);
+        }
+        let mut bounds = vec![0usize];
+        for r in 1..ranges {
+            let target = total * r as u64 / ranges as u64;
+            let b = cumulative.partition_point(|&c| c < target).clamp(*bounds.last().expect("starts at 0"), n);
+            bounds.push(b);
+        }
+        bounds.push(n);
+        let mut cross_from = Vec::with_capacity(ranges);
+        let mut halo_to = Vec::with_capacity(ranges);
+        for r in 0..ranges {
+            let (lo, hi) = (bounds[r], bounds[r + 1]);
+            cross_from.push(
+                (lo..hi)
+                    .find(|&i| list.pairs_of(i).next_back().is_some_and(|k| list.partner[k] as usize >= hi))
+                    .unwrap_or(hi),
+            );
+            halo_to.push(
+                (lo..hi)
+                    .rev()
+                    .find(|&p| {
+                        let first = list.reverse_start[p] as usize;
+                        first < list.reverse_start[p + 1] as usize && (list.reverse_first[first] as usize) < lo
+                    })
+                    .map_or(lo, |p| p + 1),
+            );
+        }
+        RangePlan {
+            bounds,
+            cross_from,
+            halo_to,
+        }
+    }
+}
+
 /// Splits `data` into consecutive mutable pieces ending at the given offsets.
 fn split_by_offsets<'a, T>(mut data: &'a mut [T], ends: &[usize]) -> Vec<&'a mut [T]> {
     let mut out = Vec::with_capacity(ends.len());
@@ -493,11 +554,9 @@ fn parallel<const WB: bool, const TH: bool>(
     torque: &mut [Vec3],
     velocity: &mut [Vec3],
     omega: &mut [Vec3],
-    threads: usize,
+    plan: &RangePlan,
 ) -> ForcePass {
-    let n = ctx.p.len();
-    let ranges = threads.clamp(1, n.max(1));
-    let bounds: Vec<usize> = (0..=ranges).map(|r| r * n / ranges).collect();
+    let bounds = &plan.bounds;
     let particle_ends = &bounds[1..];
     let pair_ends: Vec<usize> = particle_ends.iter().map(|&b| list.start[b] as usize).collect();
     let wall_ends: Vec<usize> = particle_ends.iter().map(|&b| list.wall_start[b] as usize).collect();
@@ -524,7 +583,7 @@ fn parallel<const WB: bool, const TH: bool>(
                 let (lo, hi) = (bounds[r], bounds[r + 1]);
                 let base = list.start[lo] as usize;
                 let mut worst = WorstOverlap::NONE;
-                for i in lo..hi {
+                for i in plan.cross_from[r]..hi {
                     for k in list.pairs_of(i) {
                         let j = list.partner[k] as usize;
                         if j < hi {
@@ -567,9 +626,10 @@ fn parallel<const WB: bool, const TH: bool>(
             let wall_base = list.wall_start[lo] as usize;
             let mut worst = WorstOverlap::NONE;
             // Contributions from earlier ranges come first in the serial order (ascending first particle).
-            for (local, (f, t)) in fc.iter_mut().zip(tc.iter_mut()).enumerate() {
-                *f = Vec3::zeros();
-                *t = Vec3::zeros();
+            fc.fill(Vec3::zeros());
+            tc.fill(Vec3::zeros());
+            let halo = plan.halo_to[r] - lo;
+            for (local, (f, t)) in fc[..halo].iter_mut().zip(tc[..halo].iter_mut()).enumerate() {
                 let p = lo + local;
                 let entries = list.reverse_start[p] as usize..list.reverse_start[p + 1] as usize;
                 for e in entries {

@@ -9,7 +9,7 @@ use std::sync::Arc;
 use std::time::{Duration, Instant};
 
 use super::contacts::AlignedHistory;
-use super::forces::{ForcePass, HalfKick, PairBuffers, compute_contact_forces};
+use super::forces::{ForcePass, HalfKick, PairBuffers, RangePlan, compute_contact_forces};
 use super::geometry::{Domain, Gravity, Wall};
 use super::integrate::{InverseInertia, find_lost, kick_drift};
 use super::models::{ContactLaw, PairTable};
@@ -56,6 +56,8 @@ pub struct Simulation {
     history: AlignedHistory,
     buffers: PairBuffers,
     inverse: InverseInertia,
+    /// Particle ranges of the parallel force pass, rebalanced at every neighbour-list build.
+    ranges: RangePlan,
     pool: Arc<rayon::ThreadPool>,
     pub timers: StageTimers,
 }
@@ -83,6 +85,7 @@ impl Simulation {
             history: AlignedHistory::default(),
             buffers: PairBuffers::default(),
             inverse,
+            ranges: RangePlan::default(),
             pool: make_pool(threads),
             timers: StageTimers::default(),
         };
@@ -108,6 +111,7 @@ impl Simulation {
             history: AlignedHistory::default(),
             buffers: PairBuffers::default(),
             inverse,
+            ranges: RangePlan::default(),
             pool: make_pool(threads),
             timers: StageTimers::default(),
         };
@@ -125,6 +129,7 @@ impl Simulation {
             return Err(NumericalError::OrphanContacts { count: orphans });
         }
         sim.history = history;
+        sim.rebalance();
         Ok(sim)
     }
 
@@ -281,7 +286,6 @@ impl Simulation {
 
     /// Contact forces at the current positions; with `kick`, also the second half kick.
     fn forces(&mut self, dt: f64, kick: Option<HalfKick>) -> ForcePass {
-        let threads = self.threads();
         compute_contact_forces(
             &self.config,
             &mut self.particles,
@@ -291,9 +295,13 @@ impl Simulation {
             &self.list,
             &mut self.history,
             &mut self.buffers,
-            threads,
+            &self.ranges,
             kick,
         )
+    }
+
+    fn rebalance(&mut self) {
+        self.ranges = RangePlan::balanced(&self.list, &self.history.pair.touching, self.threads());
     }
 
     fn refresh_neighbors(&mut self) {
@@ -311,6 +319,7 @@ impl Simulation {
         // A contact is always a candidate of a list built from the same positions.
         debug_assert_eq!(orphans, 0, "contacts lost in a neighbour-list rebuild");
         self.history = history;
+        self.rebalance();
     }
 
     fn with_pool<R: Send>(&mut self, f: impl FnOnce(&mut Self) -> R + Send) -> R {
