@@ -493,7 +493,9 @@ impl RangePlan {
         let mut bounds = vec![0usize];
         for r in 1..ranges {
             let target = total * r as u64 / ranges as u64;
-            let b = cumulative.partition_point(|&c| c < target).clamp(*bounds.last().expect("starts at 0"), n);
+            let b = cumulative
+                .partition_point(|&c| c < target)
+                .clamp(*bounds.last().expect("starts at 0"), n);
             bounds.push(b);
         }
         bounds.push(n);
@@ -503,7 +505,11 @@ impl RangePlan {
             let (lo, hi) = (bounds[r], bounds[r + 1]);
             cross_from.push(
                 (lo..hi)
-                    .find(|&i| list.pairs_of(i).next_back().is_some_and(|k| list.partner[k] as usize >= hi))
+                    .find(|&i| {
+                        list.pairs_of(i)
+                            .next_back()
+                            .is_some_and(|k| list.partner[k] as usize >= hi)
+                    })
                     .unwrap_or(hi),
             );
             halo_to.push(

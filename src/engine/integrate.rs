@@ -32,6 +32,7 @@ impl InverseInertia {
 }
 
 /// v += ½dt (F/m + g), ω += ½dt T/I (the LIGGGHTS dtf/m form).
+#[allow(clippy::too_many_arguments)]
 #[inline(always)]
 pub fn half_kick_one(
     v: &mut Vec3,

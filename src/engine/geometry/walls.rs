@@ -42,7 +42,7 @@ impl RotatingFrame {
 
     /// In-plane coordinates (u, v) of world point `p` in the frame turned by `angle_rad`.
     #[inline]
-    fn to_body(&self, p: &Vec3, angle_rad: f64) -> (f64, f64) {
+    fn body_coordinates(&self, p: &Vec3, angle_rad: f64) -> (f64, f64) {
         let r = p - self.axis_point_m;
         let (u, v) = (r.dot(&self.e1), r.dot(&self.e2));
         let (s, c) = angle_rad.sin_cos();
@@ -51,7 +51,7 @@ impl RotatingFrame {
 
     /// World vector of in-plane body vector (du, dv) in the frame turned by `angle_rad`.
     #[inline]
-    fn to_world_vector(&self, du: f64, dv: f64, angle_rad: f64) -> Vec3 {
+    fn world_vector(&self, du: f64, dv: f64, angle_rad: f64) -> Vec3 {
         let (s, c) = angle_rad.sin_cos();
         self.e1 * (du * c - dv * s) + self.e2 * (du * s + dv * c)
     }
@@ -151,7 +151,7 @@ impl Wall {
                 end_m,
                 half_thickness_m,
             } => {
-                let (u, v) = frame.to_body(x, angle_rad);
+                let (u, v) = frame.body_coordinates(x, angle_rad);
                 let (su, sv) = (end_m[0] - start_m[0], end_m[1] - start_m[1]);
                 let len2 = su * su + sv * sv;
                 let t = if len2 > 0.0 {
@@ -162,9 +162,9 @@ impl Wall {
                 let (du, dv) = (u - start_m[0] - t * su, v - start_m[1] - t * sv);
                 let dist = (du * du + dv * dv).sqrt();
                 let normal = if dist > 0.0 {
-                    frame.to_world_vector(du / dist, dv / dist, angle_rad)
+                    frame.world_vector(du / dist, dv / dist, angle_rad)
                 } else {
-                    frame.to_world_vector(-sv, su, angle_rad).normalize()
+                    frame.world_vector(-sv, su, angle_rad).normalize()
                 };
                 let contact_point = x - normal * (dist - half_thickness_m);
                 WallProximity {
