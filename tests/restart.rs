@@ -210,3 +210,21 @@ fn truncated_checkpoint_is_rejected_with_its_name() {
     let err = read_checkpoint(&newest).expect_err("truncated file is rejected");
     assert!(err.to_string().contains(&*newest.to_string_lossy()), "{err}");
 }
+
+/// `run_steps(n)` fuses each step's first half into the previous step's force loop; one step at a time does not.
+/// Both must give the same bits, on one and on two threads.
+#[test]
+fn fused_and_unfused_stepping_are_bit_identical() {
+    let b = built(DRUM);
+    for threads in [1, 2] {
+        let mut fused = simulation(&b, threads);
+        fused.run_steps(700).expect("stable");
+        let mut single = simulation(&b, threads);
+        for _ in 0..700 {
+            single.step().expect("stable");
+        }
+        if let Some(diff) = first_difference(&fused.snapshot(), &single.snapshot()) {
+            panic!("{threads} thread(s): fused stepping differs from single steps: {diff}");
+        }
+    }
+}

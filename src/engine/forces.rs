@@ -99,20 +99,31 @@ impl WorstOverlap {
 pub struct HalfKick {
     pub gravity: Vec3,
     pub dt_s: f64,
+    /// Also apply the next step's first half kick and drift to the particle (same gravity: both are at the end
+    /// time of this step), saving the next step a sweep over the particle arrays. The state is then between
+    /// steps; `Simulation` does this only when it runs the next step right after.
+    pub fuse_next_drift: bool,
 }
 
-/// Read access to velocities: plain slices while nothing writes them, cells while the serial loop kicks in place.
-trait Velocities {
+/// Read access to positions and velocities: plain slices while nothing writes them, cells while a serial loop
+/// kicks (and drifts) particles in place.
+trait Motion {
+    fn x(&self, i: usize) -> Vec3;
     fn v(&self, i: usize) -> Vec3;
     fn w(&self, i: usize) -> Vec3;
 }
 
 struct Plain<'a> {
+    x: &'a [Vec3],
     v: &'a [Vec3],
     w: &'a [Vec3],
 }
 
-impl Velocities for Plain<'_> {
+impl Motion for Plain<'_> {
+    #[inline(always)]
+    fn x(&self, i: usize) -> Vec3 {
+        self.x[i]
+    }
     #[inline(always)]
     fn v(&self, i: usize) -> Vec3 {
         self.v[i]
@@ -123,30 +134,37 @@ impl Velocities for Plain<'_> {
     }
 }
 
+/// Cells over a range of particles starting at `base` (0 for all particles), indexed by global particle index.
 struct Cells<'a> {
-    v: &'a [Cell<Vec3>],
-    w: &'a [Cell<Vec3>],
-}
-
-impl Velocities for Cells<'_> {
-    #[inline(always)]
-    fn v(&self, i: usize) -> Vec3 {
-        self.v[i].get()
-    }
-    #[inline(always)]
-    fn w(&self, i: usize) -> Vec3 {
-        self.w[i].get()
-    }
-}
-
-/// Cells over one range of particles, indexed by global particle index.
-struct RangeCells<'a> {
+    x: &'a [Cell<Vec3>],
     v: &'a [Cell<Vec3>],
     w: &'a [Cell<Vec3>],
     base: usize,
 }
 
-impl Velocities for RangeCells<'_> {
+impl<'a> Cells<'a> {
+    fn new(x: &'a mut [Vec3], v: &'a mut [Vec3], w: &'a mut [Vec3], base: usize) -> Self {
+        Cells {
+            x: Cell::from_mut(x).as_slice_of_cells(),
+            v: Cell::from_mut(v).as_slice_of_cells(),
+            w: Cell::from_mut(w).as_slice_of_cells(),
+            base,
+        }
+    }
+
+    #[inline(always)]
+    fn set(&self, i: usize, x: Vec3, v: Vec3, w: Vec3) {
+        self.x[i - self.base].set(x);
+        self.v[i - self.base].set(v);
+        self.w[i - self.base].set(w);
+    }
+}
+
+impl Motion for Cells<'_> {
+    #[inline(always)]
+    fn x(&self, i: usize) -> Vec3 {
+        self.x[i - self.base].get()
+    }
     #[inline(always)]
     fn v(&self, i: usize) -> Vec3 {
         self.v[i - self.base].get()
@@ -167,6 +185,8 @@ struct Context<'a> {
     wall_angle: &'a [f64],
     dt_s: f64,
     kick: Option<HalfKick>,
+    /// Positions at the last neighbour-list build, for the fused drift's displacement check (empty = none).
+    reference: &'a [Vec3],
 }
 
 /// Result of one particle–particle contact: force on i, torques on i and j.
@@ -184,13 +204,13 @@ impl Context<'_> {
         &self,
         i: usize,
         j: usize,
-        vel: &impl Velocities,
+        vel: &impl Motion,
         hist: &mut ColumnsMut,
         k: usize,
         worst: &mut WorstOverlap,
     ) -> Option<PairResult> {
         let p = self.p;
-        let d = self.config.domain.separation(&p.position_m[i], &p.position_m[j]);
+        let d = self.config.domain.separation(&vel.x(i), &vel.x(j));
         let dist2 = d.norm_squared();
         let (ri, rj) = (p.radius_m[i], p.radius_m[j]);
         let reach = ri + rj;
@@ -231,6 +251,7 @@ impl Context<'_> {
     fn walls<const WB: bool, const TH: bool>(
         &self,
         i: usize,
+        x: Vec3,
         vi: Vec3,
         wi: Vec3,
         wall_ids: &[u16],
@@ -241,7 +262,6 @@ impl Context<'_> {
         worst: &mut WorstOverlap,
     ) {
         let p = self.p;
-        let x = p.position_m[i];
         let ri = p.radius_m[i];
         for (offset, &w) in wall_ids.iter().enumerate() {
             let k = first_slot + offset;
@@ -271,38 +291,43 @@ impl Context<'_> {
         }
     }
 
-    /// Finishes particle i once its force and torque are complete: pseudo-2-D projection, then the half kick.
-    /// Returns the kicked (v, ω).
+    /// Finishes particle i once its force and torque are complete: pseudo-2-D projection, the half kick, and when
+    /// fusing, the next step's half kick and drift. Returns (x, v, ω) to store and the squared displacement from
+    /// the neighbour-list reference position (0 when not drifting).
     #[inline(always)]
-    fn finish(&self, i: usize, f: &mut Vec3, t: &mut Vec3, v: Vec3, w: Vec3) -> (Vec3, Vec3) {
+    fn finish(&self, i: usize, f: &mut Vec3, t: &mut Vec3, x: Vec3, v: Vec3, w: Vec3) -> (Vec3, Vec3, Vec3, f64) {
         if self.config.pseudo_2d {
             f.z = 0.0;
             t.x = 0.0;
             t.y = 0.0;
         }
-        match self.kick {
-            None => (v, w),
-            Some(k) => {
-                let half_dt = 0.5 * k.dt_s;
-                let (mut v, mut w) = (v, w);
-                half_kick_one(
-                    &mut v,
-                    &mut w,
-                    f,
-                    t,
-                    self.inverse.inv_mass_per_kg[i],
-                    self.inverse.inv_inertia_per_kg_m2[i],
-                    &(k.gravity * half_dt),
-                    half_dt,
-                );
-                if self.config.pseudo_2d {
-                    v.z = 0.0;
-                    w.x = 0.0;
-                    w.y = 0.0;
-                }
-                (v, w)
-            }
+        let Some(k) = self.kick else {
+            return (x, v, w, 0.0);
+        };
+        let half_dt = 0.5 * k.dt_s;
+        let g_half_dt = k.gravity * half_dt;
+        let (inv_m, inv_i) = (self.inverse.inv_mass_per_kg[i], self.inverse.inv_inertia_per_kg_m2[i]);
+        let (mut x, mut v, mut w) = (x, v, w);
+        half_kick_one(&mut v, &mut w, f, t, inv_m, inv_i, &g_half_dt, half_dt);
+        if self.config.pseudo_2d {
+            v.z = 0.0;
+            w.x = 0.0;
+            w.y = 0.0;
         }
+        if !k.fuse_next_drift {
+            return (x, v, w, 0.0);
+        }
+        // Exactly what `integrate::kick_drift` does for the next step, one particle at a time.
+        half_kick_one(&mut v, &mut w, f, t, inv_m, inv_i, &g_half_dt, half_dt);
+        if self.config.pseudo_2d {
+            v.z = 0.0;
+            w.x = 0.0;
+            w.y = 0.0;
+        }
+        x += v * k.dt_s;
+        self.config.domain.wrap(&mut x);
+        let d2 = self.reference.get(i).map_or(0.0, |x0| self.config.domain.separation(&x, x0).norm_squared());
+        (x, v, w, d2)
     }
 }
 
@@ -330,6 +355,8 @@ pub struct ForcePass {
     pub worst_overlap: WorstOverlap,
     /// First particle whose kicked velocity or angular velocity is not finite.
     pub non_finite: Option<usize>,
+    /// With a fused drift: the largest squared displacement from the neighbour-list reference positions.
+    pub max_displacement2_m2: f64,
 }
 
 /// Computes contact forces and torques into `p.force_n` and `p.torque_n_m` and, with `kick`, applies the second
@@ -349,8 +376,10 @@ pub fn compute_contact_forces(
 ) -> ForcePass {
     let mut force = std::mem::take(&mut p.force_n);
     let mut torque = std::mem::take(&mut p.torque_n_m);
+    let mut position = std::mem::take(&mut p.position_m);
     let mut velocity = std::mem::take(&mut p.velocity_m_per_s);
     let mut omega = std::mem::take(&mut p.angular_velocity_rad_per_s);
+    let reference = if list.reference_positions().len() == position.len() { list.reference_positions() } else { &[] };
     let ctx = Context {
         config,
         law: &config.contact_law,
@@ -360,6 +389,7 @@ pub fn compute_contact_forces(
         wall_angle,
         dt_s,
         kick,
+        reference,
     };
     // One instantiation per history layout: the layout decides which history fields exist, and knowing it at
     // compile time lets the kernels' unused fields vanish from the loop.
@@ -373,6 +403,7 @@ pub fn compute_contact_forces(
                     history,
                     &mut force,
                     &mut torque,
+                    &mut position,
                     &mut velocity,
                     &mut omega,
                 )
@@ -384,6 +415,7 @@ pub fn compute_contact_forces(
                     buffers,
                     &mut force,
                     &mut torque,
+                    &mut position,
                     &mut velocity,
                     &mut omega,
                     plan,
@@ -399,6 +431,7 @@ pub fn compute_contact_forces(
     };
     p.force_n = force;
     p.torque_n_m = torque;
+    p.position_m = position;
     p.velocity_m_per_s = velocity;
     p.angular_velocity_rad_per_s = omega;
     pass
@@ -410,6 +443,7 @@ fn serial<const WB: bool, const TH: bool>(
     history: &mut AlignedHistory,
     force: &mut [Vec3],
     torque: &mut [Vec3],
+    position: &mut [Vec3],
     velocity: &mut [Vec3],
     omega: &mut [Vec3],
 ) -> ForcePass {
@@ -417,19 +451,17 @@ fn serial<const WB: bool, const TH: bool>(
     let mut worst = WorstOverlap::NONE;
     // A NaN or infinity in any kicked velocity propagates into this sum; the culprit is looked for only then.
     let mut velocity_sum = 0.0f64;
+    let mut max_d2 = 0.0f64;
     force.fill(Vec3::zeros());
     torque.fill(Vec3::zeros());
-    let vel = Cells {
-        v: Cell::from_mut(velocity).as_slice_of_cells(),
-        w: Cell::from_mut(omega).as_slice_of_cells(),
-    };
+    let motion = Cells::new(position, velocity, omega, 0);
     let mut pairs = history.pair.view();
     let mut walls = history.wall.view();
     for i in 0..n {
         let slots = list.pairs_of(i);
         for (k, &j) in slots.clone().zip(&list.partner[slots]) {
             let j = j as usize;
-            if let Some(r) = ctx.pair::<WB, TH>(i, j, &vel, &mut pairs, k, &mut worst) {
+            if let Some(r) = ctx.pair::<WB, TH>(i, j, &motion, &mut pairs, k, &mut worst) {
                 force[i] += r.force;
                 force[j] -= r.force;
                 torque[i] += r.torque_i;
@@ -438,9 +470,10 @@ fn serial<const WB: bool, const TH: bool>(
         }
         let wall_slots = list.walls_of(i);
         let (mut f, mut t) = (force[i], torque[i]);
-        let (vi, wi) = (vel.v(i), vel.w(i));
+        let (xi, vi, wi) = (motion.x(i), motion.v(i), motion.w(i));
         ctx.walls::<WB, TH>(
             i,
+            xi,
             vi,
             wi,
             &list.wall_partner[wall_slots.clone()],
@@ -450,16 +483,17 @@ fn serial<const WB: bool, const TH: bool>(
             &mut t,
             &mut worst,
         );
-        let (v_new, w_new) = ctx.finish(i, &mut f, &mut t, vi, wi);
+        let (x_new, v_new, w_new, d2) = ctx.finish(i, &mut f, &mut t, xi, vi, wi);
         velocity_sum += (v_new.x + v_new.y + v_new.z) + (w_new.x + w_new.y + w_new.z);
-        vel.v[i].set(v_new);
-        vel.w[i].set(w_new);
+        max_d2 = max_d2.max(d2);
+        motion.set(i, x_new, v_new, w_new);
         force[i] = f;
         torque[i] = t;
     }
     ForcePass {
         worst_overlap: worst,
         non_finite: first_non_finite(velocity_sum, velocity, omega, 0),
+        max_displacement2_m2: max_d2,
     }
 }
 
@@ -558,6 +592,7 @@ fn parallel<const WB: bool, const TH: bool>(
     buffers: &mut PairBuffers,
     force: &mut [Vec3],
     torque: &mut [Vec3],
+    position: &mut [Vec3],
     velocity: &mut [Vec3],
     omega: &mut [Vec3],
     plan: &RangePlan,
@@ -579,7 +614,11 @@ fn parallel<const WB: bool, const TH: bool>(
         let ti_parts = split_by_offsets(&mut buffers.torque_on_i, &pair_ends);
         let tj_parts = split_by_offsets(&mut buffers.torque_on_j, &pair_ends);
         let on_parts = split_by_offsets(&mut buffers.touching, &pair_ends);
-        let vel = Plain { v: velocity, w: omega };
+        let vel = Plain {
+            x: position,
+            v: velocity,
+            w: omega,
+        };
         hist_parts
             .into_par_iter()
             .zip(f_parts)
@@ -618,15 +657,16 @@ fn parallel<const WB: bool, const TH: bool>(
     let wall_parts = history.wall.split(&wall_ends);
     let f_parts = split_by_offsets(force, particle_ends);
     let t_parts = split_by_offsets(torque, particle_ends);
+    let x_parts = split_by_offsets(position, particle_ends);
     let v_parts = split_by_offsets(velocity, particle_ends);
     let w_parts = split_by_offsets(omega, particle_ends);
-    let (worst_ranges, non_finite) = f_parts
+    let (worst_ranges, non_finite, max_d2) = f_parts
         .into_par_iter()
         .zip(t_parts)
-        .zip(v_parts.into_par_iter().zip(w_parts))
+        .zip(x_parts.into_par_iter().zip(v_parts.into_par_iter().zip(w_parts)))
         .zip(hist_parts.into_par_iter().zip(wall_parts))
         .enumerate()
-        .map(|(r, (((fc, tc), (vc, wc)), (mut pairs, mut walls)))| {
+        .map(|(r, (((fc, tc), (xc, (vc, wc))), (mut pairs, mut walls)))| {
             let (lo, hi) = (bounds[r], bounds[r + 1]);
             let pair_base = list.start[lo] as usize;
             let wall_base = list.wall_start[lo] as usize;
@@ -649,18 +689,15 @@ fn parallel<const WB: bool, const TH: bool>(
                     }
                 }
             }
-            let vel = RangeCells {
-                v: Cell::from_mut(vc).as_slice_of_cells(),
-                w: Cell::from_mut(wc).as_slice_of_cells(),
-                base: lo,
-            };
+            let motion = Cells::new(xc, vc, wc, lo);
             let mut velocity_sum = 0.0f64;
+            let mut max_d2 = 0.0f64;
             for i in lo..hi {
                 let slots = list.pairs_of(i);
                 for (k, &j) in slots.clone().zip(&list.partner[slots]) {
                     let j = j as usize;
                     if j < hi {
-                        if let Some(res) = ctx.pair::<WB, TH>(i, j, &vel, &mut pairs, k - pair_base, &mut worst) {
+                        if let Some(res) = ctx.pair::<WB, TH>(i, j, &motion, &mut pairs, k - pair_base, &mut worst) {
                             fc[i - lo] += res.force;
                             fc[j - lo] -= res.force;
                             tc[i - lo] += res.torque_i;
@@ -673,9 +710,10 @@ fn parallel<const WB: bool, const TH: bool>(
                 }
                 let wall_slots = list.walls_of(i);
                 let (mut f, mut t) = (fc[i - lo], tc[i - lo]);
-                let (vi, wi) = (vel.v(i), vel.w(i));
+                let (xi, vi, wi) = (motion.x(i), motion.v(i), motion.w(i));
                 ctx.walls::<WB, TH>(
                     i,
+                    xi,
                     vi,
                     wi,
                     &list.wall_partner[wall_slots.clone()],
@@ -685,21 +723,22 @@ fn parallel<const WB: bool, const TH: bool>(
                     &mut t,
                     &mut worst,
                 );
-                let (v_new, w_new) = ctx.finish(i, &mut f, &mut t, vi, wi);
+                let (x_new, v_new, w_new, d2) = ctx.finish(i, &mut f, &mut t, xi, vi, wi);
                 velocity_sum += (v_new.x + v_new.y + v_new.z) + (w_new.x + w_new.y + w_new.z);
-                vel.v[i - lo].set(v_new);
-                vel.w[i - lo].set(w_new);
+                max_d2 = max_d2.max(d2);
+                motion.set(i, x_new, v_new, w_new);
                 fc[i - lo] = f;
                 tc[i - lo] = t;
             }
-            (worst, first_non_finite(velocity_sum, vc, wc, lo))
+            (worst, first_non_finite(velocity_sum, vc, wc, lo), max_d2)
         })
         .reduce(
-            || (WorstOverlap::NONE, None),
-            |a, b| (a.0.max(b.0), a.1.min(b.1).or(a.1).or(b.1)),
+            || (WorstOverlap::NONE, None, 0.0f64),
+            |a, b| (a.0.max(b.0), a.1.min(b.1).or(a.1).or(b.1), a.2.max(b.2)),
         );
     ForcePass {
         worst_overlap: worst_cross.max(worst_ranges),
         non_finite,
+        max_displacement2_m2: max_d2,
     }
 }

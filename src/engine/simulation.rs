@@ -58,6 +58,9 @@ pub struct Simulation {
     inverse: InverseInertia,
     /// Particle ranges of the parallel force pass, rebalanced at every neighbour-list build.
     ranges: RangePlan,
+    /// Set between two steps of one `run_steps` call when the force loop has already applied the next step's
+    /// first half kick and drift: the largest squared displacement it found. Never set outside `run_steps`.
+    pending_drift: Option<f64>,
     pool: Arc<rayon::ThreadPool>,
     pub timers: StageTimers,
 }
@@ -86,6 +89,7 @@ impl Simulation {
             buffers: PairBuffers::default(),
             inverse,
             ranges: RangePlan::default(),
+            pending_drift: None,
             pool: make_pool(threads),
             timers: StageTimers::default(),
         };
@@ -112,6 +116,7 @@ impl Simulation {
             buffers: PairBuffers::default(),
             inverse,
             ranges: RangePlan::default(),
+            pending_drift: None,
             pool: make_pool(threads),
             timers: StageTimers::default(),
         };
@@ -183,29 +188,42 @@ impl Simulation {
 
     /// Advances `n` steps.
     pub fn run_steps(&mut self, n: u64) -> Result<(), NumericalError> {
-        // One hand-over to the simulation's pool for all n steps (a hand-over costs a thread wake-up).
-        self.with_pool(|s| (0..n).try_for_each(|_| s.step_inner()))
+        // One hand-over to the simulation's pool for all n steps (a hand-over costs a thread wake-up). Every step
+        // but the last hands its first half (kick + drift) of the next step to its own force loop; the state is
+        // a whole step again when this returns.
+        let result = self.with_pool(|s| (0..n).try_for_each(|k| s.step_inner(k + 1 < n)));
+        if result.is_err() {
+            // A failed step leaves no meaningful state; do not pretend the next step's drift is pending.
+            self.pending_drift = None;
+        }
+        result
     }
 
     /// Advances one time step.
     pub fn step(&mut self) -> Result<(), NumericalError> {
-        self.with_pool(|s| s.step_inner())
+        self.run_steps(1)
     }
 
-    fn step_inner(&mut self) -> Result<(), NumericalError> {
+    fn step_inner(&mut self, fuse_next_drift: bool) -> Result<(), NumericalError> {
         let dt = self.dt_s;
         let config = Arc::clone(&self.config);
         let t0 = Instant::now();
-        let g0 = config.gravity.at(self.time_s);
-        let max_displacement2 = kick_drift(
-            &mut self.particles,
-            &self.inverse,
-            &g0,
-            dt,
-            config.pseudo_2d,
-            &config.domain,
-            self.list.reference_positions(),
-        );
+        let max_displacement2 = match self.pending_drift.take() {
+            // The previous step's force loop already kicked and drifted every particle.
+            Some(d2) => d2,
+            None => {
+                let g0 = config.gravity.at(self.time_s);
+                kick_drift(
+                    &mut self.particles,
+                    &self.inverse,
+                    &g0,
+                    dt,
+                    config.pseudo_2d,
+                    &config.domain,
+                    self.list.reference_positions(),
+                )
+            }
+        };
         for (angle, wall) in self.wall_angle_rad.iter_mut().zip(&config.walls) {
             *angle += wall.angular_velocity_rad_per_s() * dt;
         }
@@ -240,8 +258,12 @@ impl Simulation {
         let kick = HalfKick {
             gravity: config.gravity.at(self.time_s),
             dt_s: dt,
+            fuse_next_drift,
         };
         let pass = self.forces(dt, Some(kick));
+        if fuse_next_drift {
+            self.pending_drift = Some(pass.max_displacement2_m2);
+        }
         let t3 = Instant::now();
         self.timers.integrate += t1 - t0;
         self.timers.neighbor += t2 - t1;
