@@ -238,7 +238,7 @@ pub fn bench_dem(opts: &DemBenchOptions) -> Result<()> {
     let t = sim.timers;
     let total = (t.force + t.neighbor + t.integrate).as_secs_f64().max(1e-12);
     println!(
-        "granflow: stages: force {:.1} %, neighbour {:.1} %, integrate {:.1} %",
+        "granflow: stages: force loop (with fused kicks and drift) {:.1} %, neighbour {:.1} %, separate kick-drift passes {:.1} %",
         100.0 * t.force.as_secs_f64() / total,
         100.0 * t.neighbor.as_secs_f64() / total,
         100.0 * t.integrate.as_secs_f64() / total

@@ -326,7 +326,10 @@ impl Context<'_> {
         }
         x += v * k.dt_s;
         self.config.domain.wrap(&mut x);
-        let d2 = self.reference.get(i).map_or(0.0, |x0| self.config.domain.separation(&x, x0).norm_squared());
+        let d2 = self
+            .reference
+            .get(i)
+            .map_or(0.0, |x0| self.config.domain.separation(&x, x0).norm_squared());
         (x, v, w, d2)
     }
 }
@@ -379,7 +382,11 @@ pub fn compute_contact_forces(
     let mut position = std::mem::take(&mut p.position_m);
     let mut velocity = std::mem::take(&mut p.velocity_m_per_s);
     let mut omega = std::mem::take(&mut p.angular_velocity_rad_per_s);
-    let reference = if list.reference_positions().len() == position.len() { list.reference_positions() } else { &[] };
+    let reference = if list.reference_positions().len() == position.len() {
+        list.reference_positions()
+    } else {
+        &[]
+    };
     let ctx = Context {
         config,
         law: &config.contact_law,
