@@ -78,8 +78,9 @@ fn column<T: Clone + Default>(present: bool, len: usize) -> Vec<T> {
     if present { vec![T::default(); len] } else { Vec::new() }
 }
 
-/// Splits `data` (which is either empty or as long as the last end) into pieces ending at `ends`.
-fn split_column<'a, T>(mut data: &'a mut [T], ends: &[usize]) -> Vec<&'a mut [T]> {
+/// Splits `data` (either empty, giving empty pieces, or as long as the last end) into consecutive mutable pieces
+/// ending at `ends`.
+pub fn split_at_ends<'a, T>(mut data: &'a mut [T], ends: &[usize]) -> Vec<&'a mut [T]> {
     if data.is_empty() {
         return ends.iter().map(|_| <&mut [T]>::default()).collect();
     }
@@ -128,11 +129,11 @@ impl HistoryColumns {
     /// Disjoint views ending at the given slot offsets.
     pub fn split(&mut self, ends: &[usize]) -> Vec<ColumnsMut<'_>> {
         let layout = self.layout;
-        let mut touching = split_column(&mut self.touching, ends).into_iter();
-        let mut tangential = split_column(&mut self.tangential, ends).into_iter();
-        let mut reversal = split_column(&mut self.reversal, ends).into_iter();
-        let mut direction = split_column(&mut self.direction, ends).into_iter();
-        let mut thornton = split_column(&mut self.thornton, ends).into_iter();
+        let mut touching = split_at_ends(&mut self.touching, ends).into_iter();
+        let mut tangential = split_at_ends(&mut self.tangential, ends).into_iter();
+        let mut reversal = split_at_ends(&mut self.reversal, ends).into_iter();
+        let mut direction = split_at_ends(&mut self.direction, ends).into_iter();
+        let mut thornton = split_at_ends(&mut self.thornton, ends).into_iter();
         ends.iter()
             .map(|_| ColumnsMut {
                 layout,
@@ -176,30 +177,7 @@ impl HistoryColumns {
 }
 
 impl ColumnsMut<'_> {
-    /// The history of local slot k, for a contact that is touching.
-    #[inline(always)]
-    pub fn load(&self, k: usize) -> ContactHistory {
-        let mut h = ContactHistory {
-            active: self.touching[k],
-            ..ContactHistory::INACTIVE
-        };
-        if self.layout.tangential {
-            h.tangential = self.tangential[k];
-        }
-        if self.layout.walton_braun {
-            h.reversal_force_n = self.reversal[k];
-            h.increment_direction = self.direction[k];
-        }
-        if self.layout.thornton {
-            let t = self.thornton[k];
-            h.max_overlap_m = t.max_overlap_m;
-            h.max_normal_force_n = t.max_normal_force_n;
-            h.yielded = t.yielded;
-        }
-        h
-    }
-
-    /// [`ColumnsMut::load`] with the layout known at compile time (`WB`: Walton-Braun columns, `TH`: Thornton
+    /// The history of local slot k with the layout known at compile time (`WB`: Walton-Braun columns, `TH`: Thornton
     /// columns), so that the fields a law does not use never touch memory. Must match the view's layout.
     #[inline(always)]
     pub fn load_as<const WB: bool, const TH: bool>(&self, k: usize) -> ContactHistory {

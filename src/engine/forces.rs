@@ -16,7 +16,7 @@ use std::cell::Cell;
 use rayon::prelude::*;
 
 use super::Vec3;
-use super::contacts::{AlignedHistory, ColumnsMut};
+use super::contacts::{AlignedHistory, ColumnsMut, split_at_ends};
 use super::geometry::Wall;
 use super::integrate::{InverseInertia, half_kick_one};
 use super::models::{ContactKinematics, ContactLaw, PairTable};
@@ -291,6 +291,42 @@ impl Context<'_> {
         }
     }
 
+    /// Completes particle i once all its pair contributions are in (f, t): its walls, then [`Context::finish`],
+    /// storing the new motion. `wall_base` is the first wall slot of the history view. Returns the final (f, t).
+    #[allow(clippy::too_many_arguments)]
+    #[inline(always)]
+    fn complete<const WB: bool, const TH: bool>(
+        &self,
+        i: usize,
+        mut f: Vec3,
+        mut t: Vec3,
+        motion: &Cells,
+        list: &NeighborList,
+        walls: &mut ColumnsMut,
+        wall_base: usize,
+        tally: &mut Tally,
+    ) -> (Vec3, Vec3) {
+        let wall_slots = list.walls_of(i);
+        let (xi, vi, wi) = (motion.x(i), motion.v(i), motion.w(i));
+        self.walls::<WB, TH>(
+            i,
+            xi,
+            vi,
+            wi,
+            &list.wall_partner[wall_slots.clone()],
+            walls,
+            wall_slots.start - wall_base,
+            &mut f,
+            &mut t,
+            &mut tally.worst,
+        );
+        let (x_new, v_new, w_new, d2) = self.finish(i, &mut f, &mut t, xi, vi, wi);
+        tally.velocity_sum += (v_new.x + v_new.y + v_new.z) + (w_new.x + w_new.y + w_new.z);
+        tally.max_displacement2 = tally.max_displacement2.max(d2);
+        motion.set(i, x_new, v_new, w_new);
+        (f, t)
+    }
+
     /// Finishes particle i once its force and torque are complete: pseudo-2-D projection, the half kick, and when
     /// fusing, the next step's half kick and drift. Returns (x, v, ω) to store and the squared displacement from
     /// the neighbour-list reference position (0 when not drifting).
@@ -331,6 +367,25 @@ impl Context<'_> {
             .get(i)
             .map_or(0.0, |x0| self.config.domain.separation(&x, x0).norm_squared());
         (x, v, w, d2)
+    }
+}
+
+/// What a loop over particles accumulates besides forces.
+#[derive(Debug, Clone, Copy)]
+struct Tally {
+    worst: WorstOverlap,
+    /// A NaN or infinity in any kicked velocity propagates into this sum; the culprit is looked for only then.
+    velocity_sum: f64,
+    max_displacement2: f64,
+}
+
+impl Default for Tally {
+    fn default() -> Self {
+        Tally {
+            worst: WorstOverlap::NONE,
+            velocity_sum: 0.0,
+            max_displacement2: 0.0,
+        }
     }
 }
 
@@ -455,10 +510,7 @@ fn serial<const WB: bool, const TH: bool>(
     omega: &mut [Vec3],
 ) -> ForcePass {
     let n = ctx.p.len();
-    let mut worst = WorstOverlap::NONE;
-    // A NaN or infinity in any kicked velocity propagates into this sum; the culprit is looked for only then.
-    let mut velocity_sum = 0.0f64;
-    let mut max_d2 = 0.0f64;
+    let mut tally = Tally::default();
     force.fill(Vec3::zeros());
     torque.fill(Vec3::zeros());
     let motion = Cells::new(position, velocity, omega, 0);
@@ -468,39 +520,21 @@ fn serial<const WB: bool, const TH: bool>(
         let slots = list.pairs_of(i);
         for (k, &j) in slots.clone().zip(&list.partner[slots]) {
             let j = j as usize;
-            if let Some(r) = ctx.pair::<WB, TH>(i, j, &motion, &mut pairs, k, &mut worst) {
+            if let Some(r) = ctx.pair::<WB, TH>(i, j, &motion, &mut pairs, k, &mut tally.worst) {
                 force[i] += r.force;
                 force[j] -= r.force;
                 torque[i] += r.torque_i;
                 torque[j] += r.torque_j;
             }
         }
-        let wall_slots = list.walls_of(i);
-        let (mut f, mut t) = (force[i], torque[i]);
-        let (xi, vi, wi) = (motion.x(i), motion.v(i), motion.w(i));
-        ctx.walls::<WB, TH>(
-            i,
-            xi,
-            vi,
-            wi,
-            &list.wall_partner[wall_slots.clone()],
-            &mut walls,
-            wall_slots.start,
-            &mut f,
-            &mut t,
-            &mut worst,
-        );
-        let (x_new, v_new, w_new, d2) = ctx.finish(i, &mut f, &mut t, xi, vi, wi);
-        velocity_sum += (v_new.x + v_new.y + v_new.z) + (w_new.x + w_new.y + w_new.z);
-        max_d2 = max_d2.max(d2);
-        motion.set(i, x_new, v_new, w_new);
+        let (f, t) = ctx.complete::<WB, TH>(i, force[i], torque[i], &motion, list, &mut walls, 0, &mut tally);
         force[i] = f;
         torque[i] = t;
     }
     ForcePass {
-        worst_overlap: worst,
-        non_finite: first_non_finite(velocity_sum, velocity, omega, 0),
-        max_displacement2_m2: max_d2,
+        worst_overlap: tally.worst,
+        non_finite: first_non_finite(tally.velocity_sum, velocity, omega, 0),
+        max_displacement2_m2: tally.max_displacement2,
     }
 }
 
@@ -571,19 +605,6 @@ impl RangePlan {
     }
 }
 
-/// Splits `data` into consecutive mutable pieces ending at the given offsets.
-fn split_by_offsets<'a, T>(mut data: &'a mut [T], ends: &[usize]) -> Vec<&'a mut [T]> {
-    let mut out = Vec::with_capacity(ends.len());
-    let mut consumed = 0;
-    for &end in ends {
-        let (head, tail) = data.split_at_mut(end - consumed);
-        out.push(head);
-        data = tail;
-        consumed = end;
-    }
-    out
-}
-
 /// Several threads: the particles are cut into one contiguous range per thread.
 ///
 /// Phase A computes, in parallel, only the pairs whose partner lies in a later range (the pairs two ranges share),
@@ -617,10 +638,10 @@ fn parallel<const WB: bool, const TH: bool>(
     // Phase A: cross-range pairs, velocities only read.
     let worst_cross = {
         let hist_parts = history.pair.split(&pair_ends);
-        let f_parts = split_by_offsets(&mut buffers.force_on_i, &pair_ends);
-        let ti_parts = split_by_offsets(&mut buffers.torque_on_i, &pair_ends);
-        let tj_parts = split_by_offsets(&mut buffers.torque_on_j, &pair_ends);
-        let on_parts = split_by_offsets(&mut buffers.touching, &pair_ends);
+        let f_parts = split_at_ends(&mut buffers.force_on_i, &pair_ends);
+        let ti_parts = split_at_ends(&mut buffers.torque_on_i, &pair_ends);
+        let tj_parts = split_at_ends(&mut buffers.torque_on_j, &pair_ends);
+        let on_parts = split_at_ends(&mut buffers.touching, &pair_ends);
         let vel = Plain {
             x: position,
             v: velocity,
@@ -662,11 +683,11 @@ fn parallel<const WB: bool, const TH: bool>(
     let buffers = &*buffers;
     let hist_parts = history.pair.split(&pair_ends);
     let wall_parts = history.wall.split(&wall_ends);
-    let f_parts = split_by_offsets(force, particle_ends);
-    let t_parts = split_by_offsets(torque, particle_ends);
-    let x_parts = split_by_offsets(position, particle_ends);
-    let v_parts = split_by_offsets(velocity, particle_ends);
-    let w_parts = split_by_offsets(omega, particle_ends);
+    let f_parts = split_at_ends(force, particle_ends);
+    let t_parts = split_at_ends(torque, particle_ends);
+    let x_parts = split_at_ends(position, particle_ends);
+    let v_parts = split_at_ends(velocity, particle_ends);
+    let w_parts = split_at_ends(omega, particle_ends);
     let (worst_ranges, non_finite, max_d2) = f_parts
         .into_par_iter()
         .zip(t_parts)
@@ -677,7 +698,6 @@ fn parallel<const WB: bool, const TH: bool>(
             let (lo, hi) = (bounds[r], bounds[r + 1]);
             let pair_base = list.start[lo] as usize;
             let wall_base = list.wall_start[lo] as usize;
-            let mut worst = WorstOverlap::NONE;
             // Contributions from earlier ranges come first in the serial order (ascending first particle).
             fc.fill(Vec3::zeros());
             tc.fill(Vec3::zeros());
@@ -697,14 +717,15 @@ fn parallel<const WB: bool, const TH: bool>(
                 }
             }
             let motion = Cells::new(xc, vc, wc, lo);
-            let mut velocity_sum = 0.0f64;
-            let mut max_d2 = 0.0f64;
+            let mut tally = Tally::default();
             for i in lo..hi {
                 let slots = list.pairs_of(i);
                 for (k, &j) in slots.clone().zip(&list.partner[slots]) {
                     let j = j as usize;
                     if j < hi {
-                        if let Some(res) = ctx.pair::<WB, TH>(i, j, &motion, &mut pairs, k - pair_base, &mut worst) {
+                        if let Some(res) =
+                            ctx.pair::<WB, TH>(i, j, &motion, &mut pairs, k - pair_base, &mut tally.worst)
+                        {
                             fc[i - lo] += res.force;
                             fc[j - lo] -= res.force;
                             tc[i - lo] += res.torque_i;
@@ -715,29 +736,24 @@ fn parallel<const WB: bool, const TH: bool>(
                         tc[i - lo] += buffers.torque_on_i[k];
                     }
                 }
-                let wall_slots = list.walls_of(i);
-                let (mut f, mut t) = (fc[i - lo], tc[i - lo]);
-                let (xi, vi, wi) = (motion.x(i), motion.v(i), motion.w(i));
-                ctx.walls::<WB, TH>(
+                let (f, t) = ctx.complete::<WB, TH>(
                     i,
-                    xi,
-                    vi,
-                    wi,
-                    &list.wall_partner[wall_slots.clone()],
+                    fc[i - lo],
+                    tc[i - lo],
+                    &motion,
+                    list,
                     &mut walls,
-                    wall_slots.start - wall_base,
-                    &mut f,
-                    &mut t,
-                    &mut worst,
+                    wall_base,
+                    &mut tally,
                 );
-                let (x_new, v_new, w_new, d2) = ctx.finish(i, &mut f, &mut t, xi, vi, wi);
-                velocity_sum += (v_new.x + v_new.y + v_new.z) + (w_new.x + w_new.y + w_new.z);
-                max_d2 = max_d2.max(d2);
-                motion.set(i, x_new, v_new, w_new);
                 fc[i - lo] = f;
                 tc[i - lo] = t;
             }
-            (worst, first_non_finite(velocity_sum, vc, wc, lo), max_d2)
+            (
+                tally.worst,
+                first_non_finite(tally.velocity_sum, vc, wc, lo),
+                tally.max_displacement2,
+            )
         })
         .reduce(
             || (WorstOverlap::NONE, None, 0.0f64),
