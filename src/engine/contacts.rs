@@ -16,13 +16,6 @@ use super::particles::ParticleId;
 #[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash)]
 pub struct WallId(pub u16);
 
-/// The key of a contact: a particle and its partner, a particle of larger id or a wall.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash)]
-pub enum Partner {
-    Particle(ParticleId),
-    Wall(WallId),
-}
-
 /// The active contacts of a simulation in key order: everything about contacts that a checkpoint must hold.
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct ContactStore {

@@ -138,10 +138,6 @@ impl Particles {
         self.radius_m.iter().copied().fold(0.0, f64::max)
     }
 
-    pub fn min_radius_m(&self) -> f64 {
-        self.radius_m.iter().copied().fold(f64::INFINITY, f64::min)
-    }
-
     /// Translational plus rotational kinetic energy, in J.
     pub fn kinetic_energy_j(&self) -> f64 {
         let mut e = 0.0;

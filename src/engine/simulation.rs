@@ -167,20 +167,6 @@ impl Simulation {
         )
     }
 
-    /// Per-particle coordination number (particle–particle contacts only).
-    pub fn coordination_numbers(&self) -> Vec<u32> {
-        let mut z = vec![0u32; self.particles.len()];
-        for i in 0..self.particles.len() {
-            for k in self.list.pairs_of(i) {
-                if self.history.pair.touching[k] {
-                    z[i] += 1;
-                    z[self.list.partner[k] as usize] += 1;
-                }
-            }
-        }
-        z
-    }
-
     /// Approximate heap bytes of state and workspace.
     pub fn heap_bytes(&self) -> usize {
         self.particles.heap_bytes() + self.list.heap_bytes() + self.history.heap_bytes() + self.buffers.heap_bytes()
@@ -382,14 +368,6 @@ impl Simulation {
             }
         }
         e
-    }
-
-    /// Kinetic energy (translational + rotational) and gravitational potential energy relative to the origin.
-    pub fn mechanical_energy_j(&self) -> (f64, f64) {
-        let g = self.config.gravity.at(self.time_s);
-        let p = &self.particles;
-        let potential: f64 = (0..p.len()).map(|i| -p.mass_kg[i] * g.dot(&p.position_m[i])).sum();
-        (p.kinetic_energy_j(), potential)
     }
 
     /// Height of the bed along −g: the highest particle top, and the mean centre height, in m.
