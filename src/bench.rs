@@ -235,6 +235,13 @@ pub fn bench_dem(opts: &DemBenchOptions) -> Result<()> {
         ours.particle_steps_per_s(),
         sim.neighbor_builds()
     );
+    let (pair_contacts, wall_contacts) = sim.contact_counts();
+    println!(
+        "granflow: at the end: {:.2} candidate pairs, {:.2} particle contacts and {:.3} wall contacts per particle",
+        sim.candidate_pairs() as f64 / ours.particles as f64,
+        pair_contacts as f64 / ours.particles as f64,
+        wall_contacts as f64 / ours.particles as f64
+    );
     let t = sim.timers;
     let total = (t.force + t.neighbor + t.integrate).as_secs_f64().max(1e-12);
     println!(

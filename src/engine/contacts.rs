@@ -9,7 +9,7 @@
 
 use super::Vec3;
 use super::models::ContactHistory;
-use super::neighbor::NeighborList;
+use super::neighbor::{BUILD_CHUNK, NeighborList};
 use super::particles::ParticleId;
 
 /// Index of a wall in the scenario's wall list.
@@ -313,7 +313,96 @@ impl AlignedHistory {
         (AlignedHistory { pair, wall }, orphans)
     }
 
+    /// The histories of `old` (aligned with `old_list`) carried over to `new_list`, built from the same particles:
+    /// each particle's old and new partner lists are both sorted, so one merge per particle moves every entry, in
+    /// parallel over chunks of particles. Returns how many active contacts found no slot (a bug, as in
+    /// [`AlignedHistory::from_store`]).
+    pub fn remap(
+        &self,
+        old_list: &NeighborList,
+        new_list: &NeighborList,
+        layout: HistoryLayout,
+    ) -> (AlignedHistory, usize) {
+        use rayon::prelude::*;
+        if old_list.start.len() != new_list.start.len() {
+            // A different particle set (or no list yet): go through the keyed store.
+            return AlignedHistory::from_store(&self.to_store(old_list), new_list, layout);
+        }
+        let n = new_list.start.len().saturating_sub(1);
+        let mut pair = HistoryColumns::new(new_list.partner.len(), layout);
+        let mut wall = HistoryColumns::new(new_list.wall_partner.len(), layout);
+        let chunk_ends: Vec<usize> = (1..=n.div_ceil(BUILD_CHUNK))
+            .map(|c| (c * BUILD_CHUNK).min(n))
+            .collect();
+        let pair_ends: Vec<usize> = chunk_ends.iter().map(|&e| new_list.start[e] as usize).collect();
+        let wall_ends: Vec<usize> = chunk_ends.iter().map(|&e| new_list.wall_start[e] as usize).collect();
+        let orphans = pair
+            .split(&pair_ends)
+            .into_par_iter()
+            .zip(wall.split(&wall_ends))
+            .enumerate()
+            .map(|(c, (mut pairs, mut walls))| {
+                let lo = c * BUILD_CHUNK;
+                let hi = chunk_ends[c];
+                let (pair_base, wall_base) = (new_list.start[lo] as usize, new_list.wall_start[lo] as usize);
+                let mut orphans = 0;
+                for i in lo..hi {
+                    orphans += merge_slots(
+                        &self.pair,
+                        old_list.pairs_of(i),
+                        &old_list.partner,
+                        &mut pairs,
+                        new_list.pairs_of(i),
+                        &new_list.partner,
+                        pair_base,
+                    );
+                    orphans += merge_slots(
+                        &self.wall,
+                        old_list.walls_of(i),
+                        &old_list.wall_partner,
+                        &mut walls,
+                        new_list.walls_of(i),
+                        &new_list.wall_partner,
+                        wall_base,
+                    );
+                }
+                orphans
+            })
+            .sum();
+        (AlignedHistory { pair, wall }, orphans)
+    }
+
     pub fn heap_bytes(&self) -> usize {
         self.pair.heap_bytes() + self.wall.heap_bytes()
     }
+}
+
+/// Copies the active entries of one particle's old slots to its new slots (partners sorted ascending in both);
+/// `base` is the first slot of the `to` view. Returns the number of active entries whose partner is gone.
+fn merge_slots<P: Ord + Copy>(
+    from: &HistoryColumns,
+    old_slots: std::ops::Range<usize>,
+    old_partner: &[P],
+    to: &mut ColumnsMut,
+    new_slots: std::ops::Range<usize>,
+    new_partner: &[P],
+    base: usize,
+) -> usize {
+    let mut orphans = 0;
+    let mut next = new_slots.start;
+    for k in old_slots {
+        if !from.touching[k] {
+            continue;
+        }
+        let key = old_partner[k];
+        while next < new_slots.end && new_partner[next] < key {
+            next += 1;
+        }
+        if next < new_slots.end && new_partner[next] == key {
+            to.save(next - base, &from.get(k));
+        } else {
+            orphans += 1;
+        }
+    }
+    orphans
 }

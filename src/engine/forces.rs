@@ -12,6 +12,8 @@
 //! kicked right there instead of in another sweep over memory.
 
 use std::cell::Cell;
+use std::sync::atomic::{AtomicU64, Ordering};
+use std::time::Instant;
 
 use rayon::prelude::*;
 
@@ -21,7 +23,7 @@ use super::geometry::Wall;
 use super::integrate::{InverseInertia, half_kick_one};
 use super::models::{ContactKinematics, ContactLaw, PairTable};
 use super::neighbor::NeighborList;
-use super::particles::{ParticleId, Particles};
+use super::particles::{ParticleId, Particles, SpeciesId};
 use super::simulation::SimConfig;
 
 /// Per-slot results of cross-range pairs (multi-threaded path only).
@@ -197,12 +199,38 @@ struct PairResult {
     torque_j: Vec3,
 }
 
+/// What the pair loop of particle i reads of i, loaded once per particle rather than once per candidate.
+#[derive(Clone, Copy)]
+struct Body {
+    x: Vec3,
+    v: Vec3,
+    w: Vec3,
+    radius_m: f64,
+    mass_kg: f64,
+    species: SpeciesId,
+}
+
 impl Context<'_> {
-    /// Evaluates the pair (i, j) in local history slot `k` if it overlaps; otherwise releases the slot.
+    #[inline(always)]
+    fn body(&self, i: usize, vel: &impl Motion) -> Body {
+        Body {
+            x: vel.x(i),
+            v: vel.v(i),
+            w: vel.w(i),
+            radius_m: self.p.radius_m[i],
+            mass_kg: self.p.mass_kg[i],
+            species: self.p.species[i],
+        }
+    }
+
+    /// Evaluates the pair (i, j) in local history slot `k` if it overlaps; otherwise releases the slot. `bi` is
+    /// [`Context::body`] of i.
+    #[allow(clippy::too_many_arguments)]
     #[inline(always)]
     fn pair<const WB: bool, const TH: bool>(
         &self,
         i: usize,
+        bi: &Body,
         j: usize,
         vel: &impl Motion,
         hist: &mut ColumnsMut,
@@ -210,9 +238,9 @@ impl Context<'_> {
         worst: &mut WorstOverlap,
     ) -> Option<PairResult> {
         let p = self.p;
-        let d = self.config.domain.separation(&vel.x(i), &vel.x(j));
+        let d = self.config.domain.separation(&bi.x, &vel.x(j));
         let dist2 = d.norm_squared();
-        let (ri, rj) = (p.radius_m[i], p.radius_m[j]);
+        let (ri, rj) = (bi.radius_m, p.radius_m[j]);
         let reach = ri + rj;
         if dist2 >= reach * reach {
             hist.release(k);
@@ -222,17 +250,17 @@ impl Context<'_> {
         let n = d * (1.0 / dist);
         let overlap = reach - dist;
         worst.note(overlap, ri.min(rj), i, j as u32);
-        let (wi, wj) = (vel.w(i), vel.w(j));
-        let (mi, mj) = (p.mass_kg[i], p.mass_kg[j]);
+        let (wi, wj) = (bi.w, vel.w(j));
+        let (mi, mj) = (bi.mass_kg, p.mass_kg[j]);
         let kin = ContactKinematics {
             normal: n,
             overlap_m: overlap,
             effective_radius_m: ri * rj / reach,
             effective_mass_kg: mi * mj / (mi + mj),
-            contact_velocity: vel.v(i) - vel.v(j) - (wi * ri + wj * rj).cross(&n),
+            contact_velocity: bi.v - vel.v(j) - (wi * ri + wj * rj).cross(&n),
             relative_angular_velocity: wi - wj,
         };
-        let mat = self.table.get(p.species[i], p.species[j]);
+        let mat = self.table.get(bi.species, p.species[j]);
         let mut h = hist.load_as::<WB, TH>(k);
         let out = self.law.evaluate(mat, &kin, self.dt_s, &mut h);
         hist.save_as::<WB, TH>(k, &h);
@@ -499,6 +527,7 @@ pub fn compute_contact_forces(
     pass
 }
 
+#[allow(clippy::too_many_arguments)]
 fn serial<const WB: bool, const TH: bool>(
     ctx: &Context,
     list: &NeighborList,
@@ -518,9 +547,10 @@ fn serial<const WB: bool, const TH: bool>(
     let mut walls = history.wall.view();
     for i in 0..n {
         let slots = list.pairs_of(i);
+        let bi = ctx.body(i, &motion);
         for (k, &j) in slots.clone().zip(&list.partner[slots]) {
             let j = j as usize;
-            if let Some(r) = ctx.pair::<WB, TH>(i, j, &motion, &mut pairs, k, &mut tally.worst) {
+            if let Some(r) = ctx.pair::<WB, TH>(i, &bi, j, &motion, &mut pairs, k, &mut tally.worst) {
                 force[i] += r.force;
                 force[j] -= r.force;
                 torque[i] += r.torque_i;
@@ -538,69 +568,98 @@ fn serial<const WB: bool, const TH: bool>(
     }
 }
 
-/// How the parallel pass cuts the particles: range bounds, and per range where its cross-range pairs start and
-/// where the contributions from earlier ranges end (so neither phase scans the whole range for them).
-#[derive(Debug, Clone, Default, PartialEq)]
+/// How the parallel pass cuts the particles: range bounds, and per range where its cross-range pairs start.
+///
+/// The cut is balanced by measured time: every range records how long its share of the pass took, and the next
+/// plan scales each particle's estimated cost by its old range's measured time per unit of estimate. Any bounds give
+/// the same results (bit for bit); they only spread the work.
+#[derive(Debug, Default)]
 pub struct RangePlan {
     /// `ranges + 1` bounds from 0 to n.
     pub bounds: Vec<usize>,
     /// Per range: the first particle with a partner beyond the range (the range end if none).
     pub cross_from: Vec<usize>,
-    /// Per range: one past the last particle with a contact partner in an earlier range (the range start if none).
-    pub halo_to: Vec<usize>,
+    /// Per range: estimated cost when the plan was made.
+    estimate: Vec<f64>,
+    /// Per range: nanoseconds spent in the range's serial loop since the plan was made.
+    busy_ns: Vec<AtomicU64>,
 }
 
 impl RangePlan {
-    /// Ranges balanced by estimated work: each particle costs 1 plus 4 per touching contact it owns (contacts
-    /// dominate). Any bounds give the same results; these only spread the work (a settling column has all its
-    /// contacts at the bottom at first).
-    pub fn balanced(list: &NeighborList, touching: &[bool], ranges: usize) -> RangePlan {
+    /// Estimated relative cost of particle i: one unit for the particle, a quarter per candidate pair, two per
+    /// touching contact.
+    fn particle_cost(list: &NeighborList, touching: &[bool], i: usize) -> f64 {
+        let slots = list.pairs_of(i);
+        let contacts = touching[slots.clone()].iter().filter(|&&t| t).count();
+        1.0 + 0.25 * slots.len() as f64 + 2.0 * contacts as f64
+    }
+
+    /// A plan of `ranges` parts of equal cost, where the cost of each particle is its estimate scaled by the
+    /// measured time per unit of estimate of the range that held it in `previous` (when that plan has timings).
+    pub fn balanced(list: &NeighborList, touching: &[bool], ranges: usize, previous: Option<&RangePlan>) -> RangePlan {
         let n = list.start.len().saturating_sub(1);
         let ranges = ranges.clamp(1, n.max(1));
-        let mut cumulative = Vec::with_capacity(n + 1);
-        let mut total = 0u64;
-        cumulative.push(0u64);
+        let speed: Option<Vec<f64>> = previous.filter(|p| *p.bounds.last().unwrap_or(&0) == n).and_then(|p| {
+            let per_unit: Vec<f64> = p
+                .busy_ns
+                .iter()
+                .zip(&p.estimate)
+                .map(|(t, e)| t.load(Ordering::Relaxed) as f64 / e.max(1.0))
+                .collect();
+            let mean = per_unit.iter().sum::<f64>() / per_unit.len().max(1) as f64;
+            (mean > 0.0 && per_unit.iter().all(|&u| u > 0.0)).then(|| per_unit.iter().map(|u| u / mean).collect())
+        });
+        let mut cost = Vec::with_capacity(n);
+        let mut old_range = 0;
         for i in 0..n {
-            let contacts = touching[list.pairs_of(i)].iter().filter(|&&t| t).count() as u64;
-            total += 1 + 4 * contacts;
-            cumulative.push(total);
+            let mut c = Self::particle_cost(list, touching, i);
+            if let (Some(speed), Some(p)) = (&speed, previous) {
+                while i >= p.bounds[old_range + 1] {
+                    old_range += 1;
+                }
+                c *= speed[old_range];
+            }
+            cost.push(c);
         }
+        let total: f64 = cost.iter().sum();
         let mut bounds = vec![0usize];
-        for r in 1..ranges {
-            let target = total * r as u64 / ranges as u64;
-            let b = cumulative
-                .partition_point(|&c| c < target)
-                .clamp(*bounds.last().expect("starts at 0"), n);
-            bounds.push(b);
+        let mut running = 0.0;
+        let mut next = 1;
+        for (i, c) in cost.iter().enumerate() {
+            while next < ranges && running >= total * next as f64 / ranges as f64 {
+                bounds.push(i);
+                next += 1;
+            }
+            running += c;
+        }
+        while bounds.len() < ranges {
+            bounds.push(n);
         }
         bounds.push(n);
-        let mut cross_from = Vec::with_capacity(ranges);
-        let mut halo_to = Vec::with_capacity(ranges);
-        for r in 0..ranges {
-            let (lo, hi) = (bounds[r], bounds[r + 1]);
-            cross_from.push(
+        let cross_from = (0..ranges)
+            .map(|r| {
+                let (lo, hi) = (bounds[r], bounds[r + 1]);
                 (lo..hi)
                     .find(|&i| {
                         list.pairs_of(i)
                             .next_back()
                             .is_some_and(|k| list.partner[k] as usize >= hi)
                     })
-                    .unwrap_or(hi),
-            );
-            halo_to.push(
-                (lo..hi)
-                    .rev()
-                    .find(|&p| {
-                        let first = list.reverse_start[p] as usize;
-                        first < list.reverse_start[p + 1] as usize && (list.reverse_first[first] as usize) < lo
-                    })
-                    .map_or(lo, |p| p + 1),
-            );
-        }
+                    .unwrap_or(hi)
+            })
+            .collect();
+        let estimate = (0..ranges)
+            .map(|r| {
+                (bounds[r]..bounds[r + 1])
+                    .map(|i| Self::particle_cost(list, touching, i))
+                    .sum()
+            })
+            .collect();
         RangePlan {
             bounds,
             cross_from,
-            halo_to,
+            estimate,
+            busy_ns: (0..ranges).map(|_| AtomicU64::new(0)).collect(),
         }
     }
 }
@@ -657,13 +716,14 @@ fn parallel<const WB: bool, const TH: bool>(
                 let base = list.start[lo] as usize;
                 let mut worst = WorstOverlap::NONE;
                 for i in plan.cross_from[r]..hi {
+                    let bi = ctx.body(i, &vel);
                     for k in list.pairs_of(i) {
                         let j = list.partner[k] as usize;
                         if j < hi {
                             continue;
                         }
                         let local = k - base;
-                        match ctx.pair::<WB, TH>(i, j, &vel, &mut hist, local, &mut worst) {
+                        match ctx.pair::<WB, TH>(i, &bi, j, &vel, &mut hist, local, &mut worst) {
                             Some(res) => {
                                 fb[local] = res.force;
                                 tib[local] = res.torque_i;
@@ -695,24 +755,28 @@ fn parallel<const WB: bool, const TH: bool>(
         .zip(hist_parts.into_par_iter().zip(wall_parts))
         .enumerate()
         .map(|(r, (((fc, tc), (xc, (vc, wc))), (mut pairs, mut walls)))| {
+            let started = Instant::now();
             let (lo, hi) = (bounds[r], bounds[r + 1]);
             let pair_base = list.start[lo] as usize;
             let wall_base = list.wall_start[lo] as usize;
-            // Contributions from earlier ranges come first in the serial order (ascending first particle).
+            // Contributions from earlier ranges come first in the serial order (ascending first particle): they
+            // can only come from the cross-range parts of earlier ranges, scanned in ascending order.
             fc.fill(Vec3::zeros());
             tc.fill(Vec3::zeros());
-            let halo = plan.halo_to[r] - lo;
-            for (local, (f, t)) in fc[..halo].iter_mut().zip(tc[..halo].iter_mut()).enumerate() {
-                let p = lo + local;
-                let entries = list.reverse_start[p] as usize..list.reverse_start[p + 1] as usize;
-                for e in entries {
-                    if list.reverse_first[e] as usize >= lo {
-                        break;
-                    }
-                    let slot = list.reverse_slot[e] as usize;
-                    if buffers.touching[slot] {
-                        *f -= buffers.force_on_i[slot];
-                        *t += buffers.torque_on_j[slot];
+            for earlier in 0..r {
+                for i in plan.cross_from[earlier]..bounds[earlier + 1] {
+                    let slots = list.pairs_of(i);
+                    let partners = &list.partner[slots.clone()];
+                    let first = partners.partition_point(|&j| (j as usize) < lo);
+                    for (k, &j) in slots.clone().zip(partners).skip(first) {
+                        let j = j as usize;
+                        if j >= hi {
+                            break;
+                        }
+                        if buffers.touching[k] {
+                            fc[j - lo] -= buffers.force_on_i[k];
+                            tc[j - lo] += buffers.torque_on_j[k];
+                        }
                     }
                 }
             }
@@ -720,11 +784,12 @@ fn parallel<const WB: bool, const TH: bool>(
             let mut tally = Tally::default();
             for i in lo..hi {
                 let slots = list.pairs_of(i);
+                let bi = ctx.body(i, &motion);
                 for (k, &j) in slots.clone().zip(&list.partner[slots]) {
                     let j = j as usize;
                     if j < hi {
                         if let Some(res) =
-                            ctx.pair::<WB, TH>(i, j, &motion, &mut pairs, k - pair_base, &mut tally.worst)
+                            ctx.pair::<WB, TH>(i, &bi, j, &motion, &mut pairs, k - pair_base, &mut tally.worst)
                         {
                             fc[i - lo] += res.force;
                             fc[j - lo] -= res.force;
@@ -749,6 +814,7 @@ fn parallel<const WB: bool, const TH: bool>(
                 fc[i - lo] = f;
                 tc[i - lo] = t;
             }
+            plan.busy_ns[r].fetch_add(started.elapsed().as_nanos() as u64, Ordering::Relaxed);
             (
                 tally.worst,
                 first_non_finite(tally.velocity_sum, vc, wc, lo),

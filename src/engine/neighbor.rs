@@ -1,9 +1,8 @@
 //! Neighbour search: cell lists with a skin, producing a half list of candidate pairs in a deterministic order.
 //!
 //! The list is compressed-sparse-row: the candidates of particle i are the partners j > i in
-//! `partner[start[i]..start[i+1]]`, sorted ascending. The transpose (`reverse_*`) lists, for each j, the pair slots
-//! whose partner is j in ascending i, which is the order the parallel force gather needs to reproduce the serial
-//! scatter bit for bit. Particle–wall candidates are a second CSR (`wall_*`) with wall indices ascending.
+//! `partner[start[i]..start[i+1]]`, sorted ascending. Particle–wall candidates are a second CSR (`wall_*`) with wall
+//! indices ascending. Both are built in parallel over chunks of particles; only the binning into cells is serial.
 //!
 //! This is workspace: it is rebuilt when any particle has moved more than half the skin (or a moving wall more
 //! than half the skin) and is never checkpointed. What it finds does not depend on when it was built, so results do
@@ -15,17 +14,12 @@ use super::Vec3;
 use super::geometry::{Domain, Wall};
 
 /// Particles per parallel work item in the build.
-const BUILD_CHUNK: usize = 512;
+pub const BUILD_CHUNK: usize = 1024;
 
 #[derive(Debug, Clone, Default)]
 pub struct NeighborList {
     pub start: Vec<u32>,
     pub partner: Vec<u32>,
-    pub reverse_start: Vec<u32>,
-    /// Pair slot indices (into `partner`) grouped by partner, ascending in the first particle.
-    pub reverse_slot: Vec<u32>,
-    /// The first particle of each `reverse_slot` entry.
-    pub reverse_first: Vec<u32>,
     pub wall_start: Vec<u32>,
     pub wall_partner: Vec<u16>,
     /// Positions and wall angles when the list was built.
@@ -33,6 +27,87 @@ pub struct NeighborList {
     reference_wall_angle: Vec<f64>,
     skin_m: f64,
     pub builds: u64,
+}
+
+/// Particles sorted into cubic-ish cells of at least the interaction range.
+struct CellGrid {
+    dims: [usize; 3],
+    /// Cell coordinates of each particle.
+    cell: Vec<[u32; 3]>,
+    /// Particles of cell c are `particle[start[c]..start[c+1]]`, ascending.
+    start: Vec<u32>,
+    particle: Vec<u32>,
+}
+
+impl CellGrid {
+    fn new(domain: &Domain, position: &[Vec3], cell_size_m: f64) -> Self {
+        let length = domain.length_m();
+        let mut dims = [1usize; 3];
+        for axis in 0..3 {
+            dims[axis] = ((length[axis] / cell_size_m).floor() as usize).max(1);
+        }
+        let cell: Vec<[u32; 3]> = position
+            .par_iter()
+            .with_min_len(BUILD_CHUNK)
+            .map(|x| {
+                let mut c = [0u32; 3];
+                for axis in 0..3 {
+                    let f = (x[axis] - domain.lo_m[axis]) / length[axis] * dims[axis] as f64;
+                    c[axis] = (f.floor().max(0.0) as usize).min(dims[axis] - 1) as u32;
+                }
+                c
+            })
+            .collect();
+        let n_cells = dims[0] * dims[1] * dims[2];
+        let mut grid = CellGrid {
+            dims,
+            cell,
+            start: vec![0u32; n_cells + 1],
+            particle: vec![0u32; position.len()],
+        };
+        // Counting sort; stable, so each cell lists its particles in ascending index.
+        for k in 0..grid.cell.len() {
+            let f = grid.flat(grid.cell[k]);
+            grid.start[f + 1] += 1;
+        }
+        for k in 0..n_cells {
+            grid.start[k + 1] += grid.start[k];
+        }
+        let mut fill = grid.start.clone();
+        for i in 0..grid.cell.len() {
+            let f = grid.flat(grid.cell[i]);
+            grid.particle[fill[f] as usize] = i as u32;
+            fill[f] += 1;
+        }
+        grid
+    }
+
+    #[inline]
+    fn flat(&self, c: [u32; 3]) -> usize {
+        (c[2] as usize * self.dims[1] + c[1] as usize) * self.dims[0] + c[0] as usize
+    }
+
+    /// The distinct cell coordinates next to `c` along `axis` (itself included), wrapped on periodic axes.
+    #[inline]
+    fn adjacent(&self, c: u32, axis: usize, periodic: bool) -> ([u32; 3], usize) {
+        let m = self.dims[axis] as i64;
+        let mut out = [0u32; 3];
+        let mut len = 0;
+        for d in -1i64..=1 {
+            let mut v = c as i64 + d;
+            if v < 0 || v >= m {
+                if !periodic {
+                    continue;
+                }
+                v = v.rem_euclid(m);
+            }
+            if !out[..len].contains(&(v as u32)) {
+                out[len] = v as u32;
+                len += 1;
+            }
+        }
+        (out, len)
+    }
 }
 
 impl NeighborList {
@@ -91,96 +166,60 @@ impl NeighborList {
     ) {
         let n = position.len();
         let max_radius = radius.iter().copied().fold(0.0, f64::max);
-        let cell_size = 2.0 * max_radius + skin_m;
-        let length = domain.length_m();
-        let mut dims = [1usize; 3];
-        for axis in 0..3 {
-            dims[axis] = ((length[axis] / cell_size).floor() as usize).max(1);
-        }
-        let cell_of = |x: &Vec3| -> [usize; 3] {
-            let mut c = [0usize; 3];
-            for axis in 0..3 {
-                let f = (x[axis] - domain.lo_m[axis]) / length[axis] * dims[axis] as f64;
-                c[axis] = (f.floor().max(0.0) as usize).min(dims[axis] - 1);
-            }
-            c
-        };
-        let flat = |c: [usize; 3]| (c[2] * dims[1] + c[1]) * dims[0] + c[0];
-        let n_cells = dims[0] * dims[1] * dims[2];
+        let grid = CellGrid::new(domain, position, 2.0 * max_radius + skin_m);
 
-        // Counting sort of particles into cells; stable, so each cell lists particles in ascending index.
-        let cells: Vec<[usize; 3]> = position.iter().map(cell_of).collect();
-        let mut cell_start = vec![0u32; n_cells + 1];
-        for c in &cells {
-            cell_start[flat(*c) + 1] += 1;
+        struct Chunk {
+            partners: Vec<u32>,
+            counts: Vec<u32>,
+            walls: Vec<u16>,
+            wall_counts: Vec<u32>,
         }
-        for k in 0..n_cells {
-            cell_start[k + 1] += cell_start[k];
-        }
-        let mut fill = cell_start.clone();
-        let mut cell_particle = vec![0u32; n];
-        for (i, c) in cells.iter().enumerate() {
-            let f = flat(*c);
-            cell_particle[fill[f] as usize] = i as u32;
-            fill[f] += 1;
-        }
-
-        let chunks: Vec<(Vec<u32>, Vec<u32>)> = (0..n.div_ceil(BUILD_CHUNK))
+        let chunks: Vec<Chunk> = (0..n.div_ceil(BUILD_CHUNK))
             .into_par_iter()
             .map(|chunk| {
                 let lo = chunk * BUILD_CHUNK;
                 let hi = (lo + BUILD_CHUNK).min(n);
-                let mut partners = Vec::with_capacity((hi - lo) * 8);
-                let mut counts = Vec::with_capacity(hi - lo);
-                let mut neighbor_cells: Vec<usize> = Vec::with_capacity(27);
+                let mut out = Chunk {
+                    partners: Vec::with_capacity((hi - lo) * 8),
+                    counts: Vec::with_capacity(hi - lo),
+                    walls: Vec::new(),
+                    wall_counts: Vec::with_capacity(hi - lo),
+                };
                 for i in lo..hi {
-                    let before = partners.len();
-                    let ci = cells[i];
-                    neighbor_cells.clear();
-                    for dz in -1i64..=1 {
-                        for dy in -1i64..=1 {
-                            for dx in -1i64..=1 {
-                                let mut c = [0usize; 3];
-                                let mut inside = true;
-                                for (axis, d) in [dx, dy, dz].into_iter().enumerate() {
-                                    let v = ci[axis] as i64 + d;
-                                    let m = dims[axis] as i64;
-                                    if v < 0 || v >= m {
-                                        if domain.periodic[axis] {
-                                            c[axis] = v.rem_euclid(m) as usize;
-                                        } else {
-                                            inside = false;
-                                        }
-                                    } else {
-                                        c[axis] = v as usize;
+                    let before = out.partners.len();
+                    let ci = grid.cell[i];
+                    let (xs, nx) = grid.adjacent(ci[0], 0, domain.periodic[0]);
+                    let (ys, ny) = grid.adjacent(ci[1], 1, domain.periodic[1]);
+                    let (zs, nz) = grid.adjacent(ci[2], 2, domain.periodic[2]);
+                    let (xi, ri) = (position[i], radius[i]);
+                    for &cz in &zs[..nz] {
+                        for &cy in &ys[..ny] {
+                            for &cx in &xs[..nx] {
+                                let c = grid.flat([cx, cy, cz]);
+                                for &j in &grid.particle[grid.start[c] as usize..grid.start[c + 1] as usize] {
+                                    let j = j as usize;
+                                    if j <= i {
+                                        continue;
+                                    }
+                                    let reach = ri + radius[j] + skin_m;
+                                    if domain.separation(&xi, &position[j]).norm_squared() < reach * reach {
+                                        out.partners.push(j as u32);
                                     }
                                 }
-                                if inside {
-                                    neighbor_cells.push(flat(c));
-                                }
                             }
                         }
                     }
-                    neighbor_cells.sort_unstable();
-                    neighbor_cells.dedup();
-                    let xi = position[i];
-                    let ri = radius[i];
-                    for &cell in &neighbor_cells {
-                        for &j in &cell_particle[cell_start[cell] as usize..cell_start[cell + 1] as usize] {
-                            let j = j as usize;
-                            if j <= i {
-                                continue;
-                            }
-                            let reach = ri + radius[j] + skin_m;
-                            if domain.separation(&xi, &position[j]).norm_squared() < reach * reach {
-                                partners.push(j as u32);
-                            }
+                    out.partners[before..].sort_unstable();
+                    out.counts.push((out.partners.len() - before) as u32);
+                    let walls_before = out.walls.len();
+                    for (w, wall) in walls.iter().enumerate() {
+                        if wall.proximity(&xi, wall_angle[w]).gap_m < ri + skin_m {
+                            out.walls.push(w as u16);
                         }
                     }
-                    partners[before..].sort_unstable();
-                    counts.push((partners.len() - before) as u32);
+                    out.wall_counts.push((out.walls.len() - walls_before) as u32);
                 }
-                (partners, counts)
+                out
             })
             .collect();
 
@@ -188,49 +227,22 @@ impl NeighborList {
         self.start.reserve(n + 1);
         self.start.push(0);
         self.partner.clear();
-        let mut total = 0u32;
-        for (partners, counts) in &chunks {
-            for c in counts {
-                total += c;
-                self.start.push(total);
-            }
-            self.partner.extend_from_slice(partners);
-        }
-
-        // Transpose by counting sort over slots in ascending first particle: ascending i within each j.
-        self.reverse_start.clear();
-        self.reverse_start.resize(n + 1, 0);
-        for &j in &self.partner {
-            self.reverse_start[j as usize + 1] += 1;
-        }
-        for k in 0..n {
-            self.reverse_start[k + 1] += self.reverse_start[k];
-        }
-        let mut fill = self.reverse_start.clone();
-        self.reverse_slot.clear();
-        self.reverse_slot.resize(self.partner.len(), 0);
-        self.reverse_first.clear();
-        self.reverse_first.resize(self.partner.len(), 0);
-        for i in 0..n {
-            for slot in self.pairs_of(i) {
-                let f = &mut fill[self.partner[slot] as usize];
-                self.reverse_slot[*f as usize] = slot as u32;
-                self.reverse_first[*f as usize] = i as u32;
-                *f += 1;
-            }
-        }
-
         self.wall_start.clear();
         self.wall_start.reserve(n + 1);
         self.wall_start.push(0);
         self.wall_partner.clear();
-        for i in 0..n {
-            for (w, wall) in walls.iter().enumerate() {
-                if wall.proximity(&position[i], wall_angle[w]).gap_m < radius[i] + skin_m {
-                    self.wall_partner.push(w as u16);
-                }
+        let (mut total, mut wall_total) = (0u32, 0u32);
+        for chunk in &chunks {
+            for c in &chunk.counts {
+                total += c;
+                self.start.push(total);
             }
-            self.wall_start.push(self.wall_partner.len() as u32);
+            self.partner.extend_from_slice(&chunk.partners);
+            for c in &chunk.wall_counts {
+                wall_total += c;
+                self.wall_start.push(wall_total);
+            }
+            self.wall_partner.extend_from_slice(&chunk.walls);
         }
 
         self.reference_position.clear();
@@ -243,13 +255,7 @@ impl NeighborList {
 
     /// Approximate heap bytes held by the lists.
     pub fn heap_bytes(&self) -> usize {
-        (self.start.capacity()
-            + self.partner.capacity()
-            + self.reverse_start.capacity()
-            + self.reverse_slot.capacity()
-            + self.reverse_first.capacity()
-            + self.wall_start.capacity())
-            * 4
+        (self.start.capacity() + self.partner.capacity() + self.wall_start.capacity()) * 4
             + self.wall_partner.capacity() * 2
             + self.reference_position.capacity() * std::mem::size_of::<Vec3>()
             + self.reference_wall_angle.capacity() * 8
@@ -260,41 +266,42 @@ impl NeighborList {
 mod tests {
     use super::*;
 
-    /// The cell-list half list equals the brute-force one, on a periodic box with few cells per axis.
+    /// The cell-list half list equals the brute-force one, on periodic boxes with many cells per axis and with only
+    /// one or two (where the adjacent cells on both sides are the same cell).
     #[test]
     fn matches_brute_force_with_periodic_axes() {
-        let domain = Domain::new(Vec3::zeros(), Vec3::new(1.0, 0.5, 0.3), [true, false, true]);
-        let mut state = 12345u64;
-        let mut rnd = || {
-            state = state
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            (state >> 11) as f64 / (1u64 << 53) as f64
-        };
-        let n = 400;
-        let position: Vec<Vec3> = (0..n).map(|_| Vec3::new(rnd(), 0.5 * rnd(), 0.3 * rnd())).collect();
-        let radius: Vec<f64> = (0..n).map(|_| 0.02 + 0.02 * rnd()).collect();
-        let mut list = NeighborList::default();
-        list.build(&domain, &position, &radius, 0.01, &[], &[]);
-        for i in 0..n {
-            let mut expected = vec![];
-            for j in i + 1..n {
-                let reach = radius[i] + radius[j] + 0.01;
-                if domain.separation(&position[i], &position[j]).norm_squared() < reach * reach {
-                    expected.push(j as u32);
+        for (hi, periodic) in [
+            (Vec3::new(1.0, 0.5, 0.3), [true, false, true]),
+            (Vec3::new(0.1, 0.2, 0.5), [true, true, false]),
+        ] {
+            let domain = Domain::new(Vec3::zeros(), hi, periodic);
+            let mut state = 12345u64;
+            let mut rnd = || {
+                state = state
+                    .wrapping_mul(6364136223846793005)
+                    .wrapping_add(1442695040888963407);
+                (state >> 11) as f64 / (1u64 << 53) as f64
+            };
+            let n = 400;
+            let position: Vec<Vec3> = (0..n)
+                .map(|_| Vec3::new(hi.x * rnd(), hi.y * rnd(), hi.z * rnd()))
+                .collect();
+            let radius: Vec<f64> = (0..n).map(|_| 0.02 + 0.02 * rnd()).collect();
+            let mut list = NeighborList::default();
+            list.build(&domain, &position, &radius, 0.01, &[], &[]);
+            for i in 0..n {
+                let mut expected = vec![];
+                for j in i + 1..n {
+                    let reach = radius[i] + radius[j] + 0.01;
+                    if domain.separation(&position[i], &position[j]).norm_squared() < reach * reach {
+                        expected.push(j as u32);
+                    }
                 }
-            }
-            assert_eq!(&list.partner[list.pairs_of(i)], expected.as_slice(), "particle {i}");
-        }
-        // The transpose lists every slot once, grouped by partner, ascending in the first particle.
-        for j in 0..n {
-            let slots = &list.reverse_slot[list.reverse_start[j] as usize..list.reverse_start[j + 1] as usize];
-            let mut last_i = None;
-            for &s in slots {
-                assert_eq!(list.partner[s as usize] as usize, j);
-                let i = list.start.partition_point(|&st| st as usize <= s as usize) - 1;
-                assert!(last_i.is_none_or(|l| l < i));
-                last_i = Some(i);
+                assert_eq!(
+                    &list.partner[list.pairs_of(i)],
+                    expected.as_slice(),
+                    "particle {i} in {hi:?}"
+                );
             }
         }
     }

@@ -18,6 +18,9 @@ use super::particles::{ParticleId, Particles, SpeciesTable};
 use super::state::{RngState, SimState};
 use super::{NumericalError, Vec3};
 
+/// Steps after which the parallel ranges are rebalanced from measured times even without a neighbour-list build.
+const REBALANCE_EVERY_STEPS: u64 = 200;
+
 /// Everything about a simulation that does not change while it runs.
 #[derive(Debug, Clone)]
 pub struct SimConfig {
@@ -61,6 +64,8 @@ pub struct Simulation {
     /// Set between two steps of one `run_steps` call when the force loop has already applied the next step's
     /// first half kick and drift: the largest squared displacement it found. Never set outside `run_steps`.
     pending_drift: Option<f64>,
+    /// Force passes since the particle ranges were last rebalanced.
+    steps_since_rebalance: u64,
     pool: Arc<rayon::ThreadPool>,
     pub timers: StageTimers,
 }
@@ -90,6 +95,7 @@ impl Simulation {
             inverse,
             ranges: RangePlan::default(),
             pending_drift: None,
+            steps_since_rebalance: 0,
             pool: make_pool(threads),
             timers: StageTimers::default(),
         };
@@ -117,6 +123,7 @@ impl Simulation {
             inverse,
             ranges: RangePlan::default(),
             pending_drift: None,
+            steps_since_rebalance: 0,
             pool: make_pool(threads),
             timers: StageTimers::default(),
         };
@@ -157,6 +164,11 @@ impl Simulation {
 
     pub fn neighbor_builds(&self) -> u64 {
         self.list.builds
+    }
+
+    /// Number of candidate pairs in the neighbour list (each pair once).
+    pub fn candidate_pairs(&self) -> usize {
+        self.list.pair_count()
     }
 
     /// Number of active particle–particle and particle–wall contacts.
@@ -239,7 +251,10 @@ impl Simulation {
                 });
             }
             self.refresh_neighbors();
+        } else if self.threads() > 1 && self.steps_since_rebalance >= REBALANCE_EVERY_STEPS {
+            self.rebalance();
         }
+        self.steps_since_rebalance += 1;
         let t2 = Instant::now();
         let kick = HalfKick {
             gravity: config.gravity.at(self.time_s),
@@ -309,12 +324,19 @@ impl Simulation {
     }
 
     fn rebalance(&mut self) {
-        self.ranges = RangePlan::balanced(&self.list, &self.history.pair.touching, self.threads());
+        self.ranges = RangePlan::balanced(
+            &self.list,
+            &self.history.pair.touching,
+            self.threads(),
+            Some(&self.ranges),
+        );
+        self.steps_since_rebalance = 0;
     }
 
     fn refresh_neighbors(&mut self) {
         let c = &self.config;
-        let store = self.history.to_store(&self.list);
+        let old_list = std::mem::take(&mut self.list);
+        self.list.builds = old_list.builds;
         self.list.build(
             &c.domain,
             &self.particles.position_m,
@@ -323,7 +345,9 @@ impl Simulation {
             &c.walls,
             &self.wall_angle_rad,
         );
-        let (history, orphans) = AlignedHistory::from_store(&store, &self.list, c.contact_law.history_layout());
+        let (history, orphans) = self
+            .history
+            .remap(&old_list, &self.list, c.contact_law.history_layout());
         // A contact is always a candidate of a list built from the same positions.
         debug_assert_eq!(orphans, 0, "contacts lost in a neighbour-list rebuild");
         self.history = history;
