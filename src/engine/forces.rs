@@ -15,8 +15,6 @@ use std::cell::Cell;
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::time::Instant;
 
-use rayon::prelude::*;
-
 use super::Vec3;
 use super::contacts::{AlignedHistory, ColumnsMut, split_at_ends};
 use super::geometry::Wall;
@@ -25,6 +23,7 @@ use super::models::{ContactKinematics, ContactLaw, PairTable};
 use super::neighbor::NeighborList;
 use super::particles::{ParticleId, Particles, SpeciesId};
 use super::simulation::SimConfig;
+use super::team::Team;
 
 /// Per-slot results of cross-range pairs (multi-threaded path only).
 #[derive(Debug, Default, Clone)]
@@ -189,6 +188,8 @@ struct Context<'a> {
     kick: Option<HalfKick>,
     /// Positions at the last neighbour-list build, for the fused drift's displacement check (empty = none).
     reference: &'a [Vec3],
+    /// The force and torque arrays are all zero on entry (the previous pass fused the next drift).
+    accumulators_zeroed: bool,
 }
 
 /// Result of one particle–particle contact: force on i, torques on i and j.
@@ -352,7 +353,12 @@ impl Context<'_> {
         tally.velocity_sum += (v_new.x + v_new.y + v_new.z) + (w_new.x + w_new.y + w_new.z);
         tally.max_displacement2 = tally.max_displacement2.max(d2);
         motion.set(i, x_new, v_new, w_new);
-        (f, t)
+        if self.kick.is_some_and(|k| k.fuse_next_drift) {
+            // The next step's pass accumulates into these arrays: leave them zero (see `compute_contact_forces`).
+            (Vec3::zeros(), Vec3::zeros())
+        } else {
+            (f, t)
+        }
     }
 
     /// Finishes particle i once its force and torque are complete: pseudo-2-D projection, the half kick, and when
@@ -447,6 +453,11 @@ pub struct ForcePass {
 
 /// Computes contact forces and torques into `p.force_n` and `p.torque_n_m` and, with `kick`, applies the second
 /// half kick to every particle.
+///
+/// The force and torque arrays are the accumulators of the pass. When the kick fuses the next step's drift, the
+/// totals are consumed at once and the arrays are left zero instead, so that the next pass (told so by
+/// `accumulators_zeroed`) need not clear them: a sweep over 48 bytes per particle saved per step. The totals are
+/// stored by every pass that does not fuse, which is the last step of every `Simulation::run_steps`.
 #[allow(clippy::too_many_arguments)]
 pub fn compute_contact_forces(
     config: &SimConfig,
@@ -458,7 +469,9 @@ pub fn compute_contact_forces(
     history: &mut AlignedHistory,
     buffers: &mut PairBuffers,
     plan: &RangePlan,
+    team: &Team,
     kick: Option<HalfKick>,
+    accumulators_zeroed: bool,
 ) -> ForcePass {
     let mut force = std::mem::take(&mut p.force_n);
     let mut torque = std::mem::take(&mut p.torque_n_m);
@@ -480,6 +493,7 @@ pub fn compute_contact_forces(
         dt_s,
         kick,
         reference,
+        accumulators_zeroed,
     };
     // One instantiation per history layout: the layout decides which history fields exist, and knowing it at
     // compile time lets the kernels' unused fields vanish from the loop.
@@ -509,6 +523,7 @@ pub fn compute_contact_forces(
                     &mut velocity,
                     &mut omega,
                     plan,
+                    team,
                 )
             }
         };
@@ -540,8 +555,10 @@ fn serial<const WB: bool, const TH: bool>(
 ) -> ForcePass {
     let n = ctx.p.len();
     let mut tally = Tally::default();
-    force.fill(Vec3::zeros());
-    torque.fill(Vec3::zeros());
+    if !ctx.accumulators_zeroed {
+        force.fill(Vec3::zeros());
+        torque.fill(Vec3::zeros());
+    }
     let motion = Cells::new(position, velocity, omega, 0);
     let mut pairs = history.pair.view();
     let mut walls = history.wall.view();
@@ -683,6 +700,7 @@ fn parallel<const WB: bool, const TH: bool>(
     velocity: &mut [Vec3],
     omega: &mut [Vec3],
     plan: &RangePlan,
+    team: &Team,
 ) -> ForcePass {
     let bounds = &plan.bounds;
     let particle_ends = &bounds[1..];
@@ -706,37 +724,38 @@ fn parallel<const WB: bool, const TH: bool>(
             v: velocity,
             w: omega,
         };
-        hist_parts
-            .into_par_iter()
+        let parts: Vec<_> = hist_parts
+            .into_iter()
             .zip(f_parts)
-            .zip(ti_parts.into_par_iter().zip(tj_parts.into_par_iter().zip(on_parts)))
-            .enumerate()
-            .map(|(r, ((mut hist, fb), (tib, (tjb, onb))))| {
-                let (lo, hi) = (bounds[r], bounds[r + 1]);
-                let base = list.start[lo] as usize;
-                let mut worst = WorstOverlap::NONE;
-                for i in plan.cross_from[r]..hi {
-                    let bi = ctx.body(i, &vel);
-                    for k in list.pairs_of(i) {
-                        let j = list.partner[k] as usize;
-                        if j < hi {
-                            continue;
+            .zip(ti_parts.into_iter().zip(tj_parts.into_iter().zip(on_parts)))
+            .collect();
+        team.map_parts(parts, |r, ((mut hist, fb), (tib, (tjb, onb)))| {
+            let (lo, hi) = (bounds[r], bounds[r + 1]);
+            let base = list.start[lo] as usize;
+            let mut worst = WorstOverlap::NONE;
+            for i in plan.cross_from[r]..hi {
+                let bi = ctx.body(i, &vel);
+                for k in list.pairs_of(i) {
+                    let j = list.partner[k] as usize;
+                    if j < hi {
+                        continue;
+                    }
+                    let local = k - base;
+                    match ctx.pair::<WB, TH>(i, &bi, j, &vel, &mut hist, local, &mut worst) {
+                        Some(res) => {
+                            fb[local] = res.force;
+                            tib[local] = res.torque_i;
+                            tjb[local] = res.torque_j;
+                            onb[local] = true;
                         }
-                        let local = k - base;
-                        match ctx.pair::<WB, TH>(i, &bi, j, &vel, &mut hist, local, &mut worst) {
-                            Some(res) => {
-                                fb[local] = res.force;
-                                tib[local] = res.torque_i;
-                                tjb[local] = res.torque_j;
-                                onb[local] = true;
-                            }
-                            None => onb[local] = false,
-                        }
+                        None => onb[local] = false,
                     }
                 }
-                worst
-            })
-            .reduce(|| WorstOverlap::NONE, WorstOverlap::max)
+            }
+            worst
+        })
+        .into_iter()
+        .fold(WorstOverlap::NONE, WorstOverlap::max)
     };
 
     // Phase B: each range in the serial order.
@@ -748,21 +767,24 @@ fn parallel<const WB: bool, const TH: bool>(
     let x_parts = split_at_ends(position, particle_ends);
     let v_parts = split_at_ends(velocity, particle_ends);
     let w_parts = split_at_ends(omega, particle_ends);
-    let (worst_ranges, non_finite, max_d2) = f_parts
-        .into_par_iter()
+    let parts: Vec<_> = f_parts
+        .into_iter()
         .zip(t_parts)
-        .zip(x_parts.into_par_iter().zip(v_parts.into_par_iter().zip(w_parts)))
-        .zip(hist_parts.into_par_iter().zip(wall_parts))
-        .enumerate()
-        .map(|(r, (((fc, tc), (xc, (vc, wc))), (mut pairs, mut walls)))| {
+        .zip(x_parts.into_iter().zip(v_parts.into_iter().zip(w_parts)))
+        .zip(hist_parts.into_iter().zip(wall_parts))
+        .collect();
+    let (worst_ranges, non_finite, max_d2) = team
+        .map_parts(parts, |r, (((fc, tc), (xc, (vc, wc))), (mut pairs, mut walls))| {
             let started = Instant::now();
             let (lo, hi) = (bounds[r], bounds[r + 1]);
             let pair_base = list.start[lo] as usize;
             let wall_base = list.wall_start[lo] as usize;
             // Contributions from earlier ranges come first in the serial order (ascending first particle): they
             // can only come from the cross-range parts of earlier ranges, scanned in ascending order.
-            fc.fill(Vec3::zeros());
-            tc.fill(Vec3::zeros());
+            if !ctx.accumulators_zeroed {
+                fc.fill(Vec3::zeros());
+                tc.fill(Vec3::zeros());
+            }
             for earlier in 0..r {
                 for i in plan.cross_from[earlier]..bounds[earlier + 1] {
                     let slots = list.pairs_of(i);
@@ -821,10 +843,10 @@ fn parallel<const WB: bool, const TH: bool>(
                 tally.max_displacement2,
             )
         })
-        .reduce(
-            || (WorstOverlap::NONE, None, 0.0f64),
-            |a, b| (a.0.max(b.0), a.1.min(b.1).or(a.1).or(b.1), a.2.max(b.2)),
-        );
+        .into_iter()
+        .fold((WorstOverlap::NONE, None, 0.0f64), |a, b| {
+            (a.0.max(b.0), a.1.min(b.1).or(a.1).or(b.1), a.2.max(b.2))
+        });
     ForcePass {
         worst_overlap: worst_cross.max(worst_ranges),
         non_finite,

@@ -12,6 +12,7 @@ pub mod neighbor;
 pub mod particles;
 pub mod simulation;
 pub mod state;
+pub mod team;
 
 /// Three-vector of f64 used everywhere in the engine.
 pub type Vec3 = nalgebra::Vector3<f64>;

@@ -16,6 +16,7 @@ use super::models::{ContactLaw, PairTable};
 use super::neighbor::NeighborList;
 use super::particles::{ParticleId, Particles, SpeciesTable};
 use super::state::{RngState, SimState};
+use super::team::Team;
 use super::{NumericalError, Vec3};
 
 /// Steps after which the parallel ranges are rebalanced from measured times even without a neighbour-list build.
@@ -64,9 +65,13 @@ pub struct Simulation {
     /// Set between two steps of one `run_steps` call when the force loop has already applied the next step's
     /// first half kick and drift: the largest squared displacement it found. Never set outside `run_steps`.
     pending_drift: Option<f64>,
+    /// The force and torque arrays are zero (the last force pass fused the next drift and consumed them).
+    accumulators_zeroed: bool,
     /// Force passes since the particle ranges were last rebalanced.
     steps_since_rebalance: u64,
     pool: Arc<rayon::ThreadPool>,
+    /// Threads of the per-step parallel force pass (same count as `pool`).
+    team: Team,
     pub timers: StageTimers,
 }
 
@@ -95,8 +100,10 @@ impl Simulation {
             inverse,
             ranges: RangePlan::default(),
             pending_drift: None,
+            accumulators_zeroed: false,
             steps_since_rebalance: 0,
             pool: make_pool(threads),
+            team: Team::new(threads),
             timers: StageTimers::default(),
         };
         sim.refresh_neighbors();
@@ -123,8 +130,10 @@ impl Simulation {
             inverse,
             ranges: RangePlan::default(),
             pending_drift: None,
+            accumulators_zeroed: false,
             steps_since_rebalance: 0,
             pool: make_pool(threads),
+            team: Team::new(threads),
             timers: StageTimers::default(),
         };
         sim.list.build(
@@ -159,7 +168,7 @@ impl Simulation {
     }
 
     pub fn threads(&self) -> usize {
-        self.pool.current_num_threads()
+        self.team.size()
     }
 
     pub fn neighbor_builds(&self) -> u64 {
@@ -190,9 +199,11 @@ impl Simulation {
         // but the last hands its first half (kick + drift) of the next step to its own force loop; the state is
         // a whole step again when this returns.
         let result = self.with_pool(|s| (0..n).try_for_each(|k| s.step_inner(k + 1 < n)));
+        self.team.rest();
         if result.is_err() {
             // A failed step leaves no meaningful state; do not pretend the next step's drift is pending.
             self.pending_drift = None;
+            self.accumulators_zeroed = false;
         }
         result
     }
@@ -309,7 +320,7 @@ impl Simulation {
 
     /// Contact forces at the current positions; with `kick`, also the second half kick.
     fn forces(&mut self, dt: f64, kick: Option<HalfKick>) -> ForcePass {
-        compute_contact_forces(
+        let pass = compute_contact_forces(
             &self.config,
             &mut self.particles,
             &self.inverse,
@@ -319,8 +330,12 @@ impl Simulation {
             &mut self.history,
             &mut self.buffers,
             &self.ranges,
+            &self.team,
             kick,
-        )
+            self.accumulators_zeroed,
+        );
+        self.accumulators_zeroed = kick.is_some_and(|k| k.fuse_next_drift);
+        pass
     }
 
     fn rebalance(&mut self) {
@@ -334,6 +349,8 @@ impl Simulation {
     }
 
     fn refresh_neighbors(&mut self) {
+        // The rebuild runs on the rayon pool: park the force-pass helpers so they do not spin on its cores.
+        self.team.rest();
         let c = &self.config;
         let old_list = std::mem::take(&mut self.list);
         self.list.builds = old_list.builds;

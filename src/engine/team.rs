@@ -1,0 +1,254 @@
+//! A fixed team of threads for the force pass, which forks and joins twice per time step.
+//!
+//! A step takes about a millisecond, and a general-purpose pool's sleeping worker takes tens of microseconds to wake
+//! (more in a virtual machine), which measurably limited the two-thread speed-up. Here the helpers spin for a short
+//! while after each job, so a job that follows within that time starts at once; past it they park on a condition
+//! variable and cost nothing. [`Team::rest`] parks them at once, before work that uses another pool (the neighbour
+//! rebuild uses rayon), so that spinning helpers do not compete with it for cores.
+//!
+//! Thread r of a job always gets index r (the caller is index 0), so a job can hand each index its own part of the
+//! data; which thread runs which part never affects results.
+
+use std::cell::UnsafeCell;
+use std::panic::{AssertUnwindSafe, catch_unwind};
+use std::sync::atomic::{AtomicBool, AtomicU64, AtomicUsize, Ordering};
+use std::sync::{Arc, Condvar, Mutex};
+use std::thread::JoinHandle;
+use std::time::{Duration, Instant};
+
+/// How long a helper spins for the next job before parking.
+const SPIN: Duration = Duration::from_micros(300);
+
+type Job = dyn Fn(usize) + Sync;
+
+struct Shared {
+    /// Bumped (SeqCst) to publish a job or a rest/stop request.
+    generation: AtomicU64,
+    /// The current job, lifetime-erased; valid while `remaining` > 0 (see [`Team::run`]).
+    job: UnsafeCell<Option<*const Job>>,
+    /// Helpers that have not finished the current job.
+    remaining: AtomicUsize,
+    /// Helpers park immediately instead of spinning (set by `rest`, cleared by `run`).
+    resting: AtomicBool,
+    stop: AtomicBool,
+    /// A helper's job panicked.
+    panicked: AtomicBool,
+    sleeping: AtomicUsize,
+    lock: Mutex<()>,
+    wake: Condvar,
+}
+
+// SAFETY: `job` is written only by the owner while no helper reads it (all helpers have finished the previous job
+// and none starts until `generation` is bumped after the write); helpers only read it.
+unsafe impl Sync for Shared {}
+unsafe impl Send for Shared {}
+
+pub struct Team {
+    shared: Arc<Shared>,
+    helpers: Vec<JoinHandle<()>>,
+}
+
+impl std::fmt::Debug for Team {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "Team({} threads)", self.size())
+    }
+}
+
+impl Team {
+    /// A team of `threads` (≥ 1): the calling thread plus `threads − 1` helpers.
+    pub fn new(threads: usize) -> Team {
+        let shared = Arc::new(Shared {
+            generation: AtomicU64::new(0),
+            job: UnsafeCell::new(None),
+            remaining: AtomicUsize::new(0),
+            resting: AtomicBool::new(true),
+            stop: AtomicBool::new(false),
+            panicked: AtomicBool::new(false),
+            sleeping: AtomicUsize::new(0),
+            lock: Mutex::new(()),
+            wake: Condvar::new(),
+        });
+        let helpers = (1..threads.max(1))
+            .map(|index| {
+                let shared = Arc::clone(&shared);
+                std::thread::Builder::new()
+                    .name(format!("granflow-team-{index}"))
+                    .spawn(move || helper(&shared, index))
+                    .expect("spawning a helper thread")
+            })
+            .collect();
+        Team { shared, helpers }
+    }
+
+    pub fn size(&self) -> usize {
+        self.helpers.len() + 1
+    }
+
+    /// Runs `job(r)` for every r in 0..size, r = 0 on the calling thread, and returns when all have finished.
+    /// A panic in any of them is resumed here after all have finished.
+    pub fn run(&self, job: &(dyn Fn(usize) + Sync)) {
+        let s = &*self.shared;
+        if self.helpers.is_empty() {
+            job(0);
+            return;
+        }
+        // SAFETY: no helper is running a job (the previous `run` waited for all), so none reads `job` now. The
+        // pointer's lifetime is erased; it is dereferenced only until `remaining` reaches 0, which this function
+        // waits for before returning, also when `job(0)` panics (the guard below).
+        unsafe {
+            let erased: *const Job = std::mem::transmute::<*const (dyn Fn(usize) + Sync + '_), *const Job>(job);
+            *s.job.get() = Some(erased);
+        }
+        s.remaining.store(self.helpers.len(), Ordering::SeqCst);
+        s.resting.store(false, Ordering::SeqCst);
+        s.generation.fetch_add(1, Ordering::SeqCst);
+        if s.sleeping.load(Ordering::SeqCst) > 0 {
+            let _guard = s.lock.lock().unwrap_or_else(|e| e.into_inner());
+            s.wake.notify_all();
+        }
+        struct WaitForHelpers<'a>(&'a Shared);
+        impl Drop for WaitForHelpers<'_> {
+            fn drop(&mut self) {
+                while self.0.remaining.load(Ordering::Acquire) > 0 {
+                    std::hint::spin_loop();
+                }
+            }
+        }
+        {
+            let _wait = WaitForHelpers(s);
+            job(0);
+        }
+        if s.panicked.swap(false, Ordering::SeqCst) {
+            panic!("a granflow team thread panicked (its message is printed above)");
+        }
+    }
+
+    /// Applies `f(k, part)` to every part, part k on thread k mod size, and returns the results in part order.
+    pub fn map_parts<P: Send, R: Send>(&self, parts: Vec<P>, f: impl Fn(usize, P) -> R + Sync) -> Vec<R> {
+        let count = parts.len();
+        let inputs: Vec<Mutex<Option<P>>> = parts.into_iter().map(|p| Mutex::new(Some(p))).collect();
+        let outputs: Vec<Mutex<Option<R>>> = (0..count).map(|_| Mutex::new(None)).collect();
+        let size = self.size();
+        self.run(&|r| {
+            for k in (r..count).step_by(size) {
+                let part = inputs[k].lock().unwrap_or_else(|e| e.into_inner()).take();
+                let part = part.expect("each part is taken once");
+                let result = f(k, part);
+                *outputs[k].lock().unwrap_or_else(|e| e.into_inner()) = Some(result);
+            }
+        });
+        outputs
+            .into_iter()
+            .map(|o| {
+                o.into_inner()
+                    .unwrap_or_else(|e| e.into_inner())
+                    .expect("every part was run")
+            })
+            .collect()
+    }
+
+    /// Parks the helpers until the next [`Team::run`].
+    pub fn rest(&self) {
+        self.shared.resting.store(true, Ordering::SeqCst);
+    }
+}
+
+impl Drop for Team {
+    fn drop(&mut self) {
+        let s = &*self.shared;
+        s.stop.store(true, Ordering::SeqCst);
+        s.generation.fetch_add(1, Ordering::SeqCst);
+        {
+            let _guard = s.lock.lock().unwrap_or_else(|e| e.into_inner());
+            s.wake.notify_all();
+        }
+        for h in self.helpers.drain(..) {
+            let _ = h.join();
+        }
+    }
+}
+
+fn helper(s: &Shared, index: usize) {
+    let mut seen = 0u64;
+    loop {
+        // Wait for a new generation: spin for a while unless resting, then park.
+        let spin_until = Instant::now() + SPIN;
+        let mut spins = 0u32;
+        while s.generation.load(Ordering::SeqCst) == seen && !s.resting.load(Ordering::Relaxed) {
+            std::hint::spin_loop();
+            spins += 1;
+            if spins % 1024 == 0 && Instant::now() > spin_until {
+                break;
+            }
+        }
+        if s.generation.load(Ordering::SeqCst) == seen {
+            let mut guard = s.lock.lock().unwrap_or_else(|e| e.into_inner());
+            s.sleeping.fetch_add(1, Ordering::SeqCst);
+            while s.generation.load(Ordering::SeqCst) == seen {
+                guard = s.wake.wait(guard).unwrap_or_else(|e| e.into_inner());
+            }
+            s.sleeping.fetch_sub(1, Ordering::SeqCst);
+        }
+        seen = s.generation.load(Ordering::SeqCst);
+        if s.stop.load(Ordering::SeqCst) {
+            return;
+        }
+        if s.remaining.load(Ordering::Acquire) == 0 {
+            // A rest request or a spurious generation with no job for us.
+            continue;
+        }
+        // SAFETY: the owner wrote `job` before bumping the generation we just saw and keeps it alive until
+        // `remaining` reaches 0, which happens only after our decrement below.
+        let job = unsafe { (*s.job.get()).expect("a job is published with its generation") };
+        let result = catch_unwind(AssertUnwindSafe(|| unsafe { (*job)(index) }));
+        if result.is_err() {
+            s.panicked.store(true, Ordering::SeqCst);
+        }
+        s.remaining.fetch_sub(1, Ordering::Release);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn every_index_runs_once_per_job_and_the_team_parks_and_wakes() {
+        let team = Team::new(3);
+        for round in 0..200u64 {
+            let hits: Vec<AtomicU64> = (0..3).map(|_| AtomicU64::new(0)).collect();
+            team.run(&|r| {
+                hits[r].fetch_add(round + 1, Ordering::Relaxed);
+            });
+            for h in &hits {
+                assert_eq!(h.load(Ordering::Relaxed), round + 1);
+            }
+            if round % 50 == 0 {
+                team.rest();
+                std::thread::sleep(Duration::from_millis(2));
+            }
+        }
+    }
+
+    #[test]
+    fn map_parts_keeps_part_order_for_any_count() {
+        let team = Team::new(2);
+        for count in [0usize, 1, 2, 5] {
+            let out = team.map_parts((0..count).map(|k| k * 10).collect(), |k, p| (k, p + 1));
+            assert_eq!(out, (0..count).map(|k| (k, k * 10 + 1)).collect::<Vec<_>>());
+        }
+    }
+
+    #[test]
+    fn a_helper_panic_reaches_the_caller() {
+        let team = Team::new(2);
+        let result = catch_unwind(AssertUnwindSafe(|| team.run(&|r| assert_ne!(r, 1, "helper fails"))));
+        assert!(result.is_err());
+        // The team still works afterwards.
+        let sum = AtomicU64::new(0);
+        team.run(&|r| {
+            sum.fetch_add(r as u64 + 1, Ordering::Relaxed);
+        });
+        assert_eq!(sum.load(Ordering::Relaxed), 3);
+    }
+}
