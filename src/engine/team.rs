@@ -177,7 +177,7 @@ fn helper(s: &Shared, index: usize) {
         while s.generation.load(Ordering::SeqCst) == seen && !s.resting.load(Ordering::Relaxed) {
             std::hint::spin_loop();
             spins += 1;
-            if spins % 1024 == 0 && Instant::now() > spin_until {
+            if spins.is_multiple_of(1024) && Instant::now() > spin_until {
                 break;
             }
         }
