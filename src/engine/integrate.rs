@@ -49,7 +49,8 @@ pub fn half_kick_one(
 }
 
 /// First half of a step: half kick and drift (wrapped on periodic axes). Returns the largest squared displacement
-/// from `reference` (the positions at the last neighbour-list build; empty = skip).
+/// from `reference` (the positions at the last neighbour-list build; empty = skip). With `parallel`, chunks run on
+/// the current rayon pool; without, on the calling thread (the same chunks, so the same bits).
 ///
 /// No checks here: velocities were checked finite by the kick that made them (`forces.rs`), so positions stay
 /// finite, and lost particles are looked for when the neighbour list is rebuilt (a particle cannot leave the box
@@ -63,23 +64,13 @@ pub fn kick_drift(
     pseudo_2d: bool,
     domain: &Domain,
     reference: &[Vec3],
+    parallel: bool,
 ) -> f64 {
     let half_dt = 0.5 * dt_s;
     let g_half_dt = gravity * half_dt;
     let check_displacement = reference.len() == p.len();
-    p.position_m
-        .par_chunks_mut(CHUNK)
-        .zip(p.velocity_m_per_s.par_chunks_mut(CHUNK))
-        .zip(p.angular_velocity_rad_per_s.par_chunks_mut(CHUNK))
-        .zip(p.force_n.par_chunks(CHUNK).zip(p.torque_n_m.par_chunks(CHUNK)))
-        .zip(
-            inverse
-                .inv_mass_per_kg
-                .par_chunks(CHUNK)
-                .zip(inverse.inv_inertia_per_kg_m2.par_chunks(CHUNK)),
-        )
-        .enumerate()
-        .map(|(c, ((((x, v), w), (f, t)), (inv_m, inv_i)))| {
+    let chunk =
+        |c: usize, x: &mut [Vec3], v: &mut [Vec3], w: &mut [Vec3], f: &[Vec3], t: &[Vec3], inv: (&[f64], &[f64])| {
             let mut max_d2 = 0.0f64;
             let reference = if check_displacement {
                 &reference[c * CHUNK..c * CHUNK + x.len()]
@@ -91,7 +82,7 @@ pub fn kick_drift(
                 .zip(v.iter_mut())
                 .zip(w.iter_mut())
                 .zip(f.iter().zip(t))
-                .zip(inv_m.iter().zip(inv_i));
+                .zip(inv.0.iter().zip(inv.1));
             for (k, ((((x, v), w), (f, t)), (&inv_m, &inv_i))) in particles.enumerate() {
                 half_kick_one(v, w, f, t, inv_m, inv_i, &g_half_dt, half_dt);
                 if pseudo_2d {
@@ -106,7 +97,37 @@ pub fn kick_drift(
                 }
             }
             max_d2
-        })
+        };
+    if !parallel {
+        return p
+            .position_m
+            .chunks_mut(CHUNK)
+            .zip(p.velocity_m_per_s.chunks_mut(CHUNK))
+            .zip(p.angular_velocity_rad_per_s.chunks_mut(CHUNK))
+            .zip(p.force_n.chunks(CHUNK).zip(p.torque_n_m.chunks(CHUNK)))
+            .zip(
+                inverse
+                    .inv_mass_per_kg
+                    .chunks(CHUNK)
+                    .zip(inverse.inv_inertia_per_kg_m2.chunks(CHUNK)),
+            )
+            .enumerate()
+            .map(|(c, ((((x, v), w), (f, t)), inv))| chunk(c, x, v, w, f, t, inv))
+            .fold(0.0, f64::max);
+    }
+    p.position_m
+        .par_chunks_mut(CHUNK)
+        .zip(p.velocity_m_per_s.par_chunks_mut(CHUNK))
+        .zip(p.angular_velocity_rad_per_s.par_chunks_mut(CHUNK))
+        .zip(p.force_n.par_chunks(CHUNK).zip(p.torque_n_m.par_chunks(CHUNK)))
+        .zip(
+            inverse
+                .inv_mass_per_kg
+                .par_chunks(CHUNK)
+                .zip(inverse.inv_inertia_per_kg_m2.par_chunks(CHUNK)),
+        )
+        .enumerate()
+        .map(|(c, ((((x, v), w), (f, t)), inv))| chunk(c, x, v, w, f, t, inv))
         .reduce(|| 0.0, f64::max)
 }
 

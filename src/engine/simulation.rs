@@ -108,7 +108,7 @@ impl Simulation {
         };
         sim.refresh_neighbors();
         // The first half kick needs F(0). With dt = 0 the tangential springs do not move.
-        let pass = sim.with_pool(|s| s.forces(0.0, None));
+        let pass = sim.forces(0.0, None);
         sim.check_overlap(pass.worst_overlap)?;
         Ok(sim)
     }
@@ -136,14 +136,16 @@ impl Simulation {
             team: Team::new(threads),
             timers: StageTimers::default(),
         };
-        sim.list.build(
-            &sim.config.domain,
-            &sim.particles.position_m,
-            &sim.particles.radius_m,
-            sim.config.skin_m,
-            &sim.config.walls,
-            &sim.wall_angle_rad,
-        );
+        sim.with_pool(|sim| {
+            sim.list.build(
+                &sim.config.domain,
+                &sim.particles.position_m,
+                &sim.particles.radius_m,
+                sim.config.skin_m,
+                &sim.config.walls,
+                &sim.wall_angle_rad,
+            )
+        });
         let layout = sim.config.contact_law.history_layout();
         let (history, orphans) = AlignedHistory::from_store(&state.contacts, &sim.list, layout);
         if orphans > 0 {
@@ -195,10 +197,11 @@ impl Simulation {
 
     /// Advances `n` steps.
     pub fn run_steps(&mut self, n: u64) -> Result<(), NumericalError> {
-        // One hand-over to the simulation's pool for all n steps (a hand-over costs a thread wake-up). Every step
+        // The force pass runs on the team and list rebuilds on the rayon pool, each handing over only when it runs
+        // (a hand-over to a sleeping thread costs a wake-up). Every step
         // but the last hands its first half (kick + drift) of the next step to its own force loop; the state is
         // a whole step again when this returns.
-        let result = self.with_pool(|s| (0..n).try_for_each(|k| s.step_inner(k + 1 < n)));
+        let result = (0..n).try_for_each(|k| self.step_inner(k + 1 < n));
         self.team.rest();
         if result.is_err() {
             // A failed step leaves no meaningful state; do not pretend the next step's drift is pending.
@@ -222,15 +225,13 @@ impl Simulation {
             Some(d2) => d2,
             None => {
                 let g0 = config.gravity.at(self.time_s);
-                kick_drift(
-                    &mut self.particles,
-                    &self.inverse,
-                    &g0,
-                    dt,
-                    config.pseudo_2d,
-                    &config.domain,
-                    self.list.reference_positions(),
-                )
+                let parallel = self.threads() > 1;
+                let (particles, inverse, reference) =
+                    (&mut self.particles, &self.inverse, self.list.reference_positions());
+                let (pseudo_2d, domain) = (config.pseudo_2d, config.domain);
+                let mut drift =
+                    move || kick_drift(particles, inverse, &g0, dt, pseudo_2d, &domain, reference, parallel);
+                if parallel { self.pool.install(drift) } else { drift() }
             }
         };
         for (angle, wall) in self.wall_angle_rad.iter_mut().zip(&config.walls) {
@@ -351,20 +352,20 @@ impl Simulation {
     fn refresh_neighbors(&mut self) {
         // The rebuild runs on the rayon pool: park the force-pass helpers so they do not spin on its cores.
         self.team.rest();
-        let c = &self.config;
         let old_list = std::mem::take(&mut self.list);
         self.list.builds = old_list.builds;
-        self.list.build(
-            &c.domain,
-            &self.particles.position_m,
-            &self.particles.radius_m,
-            c.skin_m,
-            &c.walls,
-            &self.wall_angle_rad,
-        );
-        let (history, orphans) = self
-            .history
-            .remap(&old_list, &self.list, c.contact_law.history_layout());
+        let (history, orphans) = self.with_pool(|s| {
+            let c = &s.config;
+            s.list.build(
+                &c.domain,
+                &s.particles.position_m,
+                &s.particles.radius_m,
+                c.skin_m,
+                &c.walls,
+                &s.wall_angle_rad,
+            );
+            s.history.remap(&old_list, &s.list, c.contact_law.history_layout())
+        });
         // A contact is always a candidate of a list built from the same positions.
         debug_assert_eq!(orphans, 0, "contacts lost in a neighbour-list rebuild");
         self.history = history;

@@ -109,8 +109,9 @@ impl Team {
         struct WaitForHelpers<'a>(&'a Shared);
         impl Drop for WaitForHelpers<'_> {
             fn drop(&mut self) {
+                let mut spins = 0u32;
                 while self.0.remaining.load(Ordering::Acquire) > 0 {
-                    std::hint::spin_loop();
+                    pause(&mut spins);
                 }
             }
         }
@@ -168,6 +169,18 @@ impl Drop for Team {
     }
 }
 
+/// One round of a spin wait: a CPU hint at first, then also a yield, so that a waiting thread does not hold a core
+/// that the thread it waits for needs (more threads than cores).
+#[inline]
+fn pause(spins: &mut u32) {
+    *spins = spins.wrapping_add(1);
+    if *spins < 2048 {
+        std::hint::spin_loop();
+    } else {
+        std::thread::yield_now();
+    }
+}
+
 fn helper(s: &Shared, index: usize) {
     let mut seen = 0u64;
     loop {
@@ -175,8 +188,7 @@ fn helper(s: &Shared, index: usize) {
         let spin_until = Instant::now() + SPIN;
         let mut spins = 0u32;
         while s.generation.load(Ordering::SeqCst) == seen && !s.resting.load(Ordering::Relaxed) {
-            std::hint::spin_loop();
-            spins += 1;
+            pause(&mut spins);
             if spins.is_multiple_of(1024) && Instant::now() > spin_until {
                 break;
             }
