@@ -99,21 +99,17 @@ pub fn kick_drift(
             max_d2
         };
     if !parallel {
-        return p
-            .position_m
-            .chunks_mut(CHUNK)
-            .zip(p.velocity_m_per_s.chunks_mut(CHUNK))
-            .zip(p.angular_velocity_rad_per_s.chunks_mut(CHUNK))
-            .zip(p.force_n.chunks(CHUNK).zip(p.torque_n_m.chunks(CHUNK)))
-            .zip(
-                inverse
-                    .inv_mass_per_kg
-                    .chunks(CHUNK)
-                    .zip(inverse.inv_inertia_per_kg_m2.chunks(CHUNK)),
-            )
-            .enumerate()
-            .map(|(c, ((((x, v), w), (f, t)), inv))| chunk(c, x, v, w, f, t, inv))
-            .fold(0.0, f64::max);
+        // One chunk covering every particle: the same per-particle arithmetic, and the maximum of the chunk maxima
+        // is the maximum.
+        return chunk(
+            0,
+            &mut p.position_m,
+            &mut p.velocity_m_per_s,
+            &mut p.angular_velocity_rad_per_s,
+            &p.force_n,
+            &p.torque_n_m,
+            (&inverse.inv_mass_per_kg, &inverse.inv_inertia_per_kg_m2),
+        );
     }
     p.position_m
         .par_chunks_mut(CHUNK)
