@@ -289,11 +289,17 @@ impl Simulation {
 
     fn non_finite(&self, i: usize) -> NumericalError {
         let p = &self.particles;
-        let field = if !p.force_n[i].iter().all(|a| a.is_finite()) {
+        let velocity_finite = p.velocity_m_per_s[i].iter().all(|a| a.is_finite());
+        let field = if self.accumulators_zeroed {
+            // The pass consumed the force and torque and left the arrays zero. Velocities were finite before the
+            // kick and masses, dt and gravity are, so a non-finite velocity means a non-finite force, and a
+            // non-finite angular velocity a non-finite torque.
+            if velocity_finite { "torque" } else { "force" }
+        } else if !p.force_n[i].iter().all(|a| a.is_finite()) {
             "force"
         } else if !p.torque_n_m[i].iter().all(|a| a.is_finite()) {
             "torque"
-        } else if !p.velocity_m_per_s[i].iter().all(|a| a.is_finite()) {
+        } else if !velocity_finite {
             "velocity"
         } else {
             "angular velocity"
