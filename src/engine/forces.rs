@@ -637,10 +637,11 @@ impl RangePlan {
             let mean = per_unit.iter().sum::<f64>() / per_unit.len().max(1) as f64;
             (mean > 0.0 && per_unit.iter().all(|&u| u > 0.0)).then(|| per_unit.iter().map(|u| u / mean).collect())
         });
+        let estimated: Vec<f64> = (0..n).map(|i| Self::particle_cost(list, touching, i)).collect();
         let mut cost = Vec::with_capacity(n);
         let mut old_range = 0;
-        for i in 0..n {
-            let mut c = Self::particle_cost(list, touching, i);
+        for (i, &e) in estimated.iter().enumerate() {
+            let mut c = e;
             if let (Some(speed), Some(p)) = (&speed, previous) {
                 while i >= p.bounds[old_range + 1] {
                     old_range += 1;
@@ -677,11 +678,7 @@ impl RangePlan {
             })
             .collect();
         let estimate = (0..ranges)
-            .map(|r| {
-                (bounds[r]..bounds[r + 1])
-                    .map(|i| Self::particle_cost(list, touching, i))
-                    .sum()
-            })
+            .map(|r| estimated[bounds[r]..bounds[r + 1]].iter().sum())
             .collect();
         RangePlan {
             bounds,
