@@ -349,7 +349,7 @@ impl Simulation {
         self.ranges = RangePlan::balanced(
             &self.list,
             &self.history.pair.touching,
-            self.threads(),
+            RangePlan::ranges_for(self.threads()),
             Some(&self.ranges),
         );
         self.steps_since_rebalance = 0;
