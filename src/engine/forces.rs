@@ -77,6 +77,17 @@ impl WorstOverlap {
         }
     }
 
+    /// Converts particle indices recorded relative to a range starting at `lo` into global ones (`walls` = how
+    /// many walls, whose partner codes are left as they are).
+    fn shift_particles(&mut self, lo: usize, walls: usize) {
+        if self.ratio > 0.0 {
+            self.particle += lo as u32;
+            if self.partner < u32::MAX - walls as u32 {
+                self.partner += lo as u32;
+            }
+        }
+    }
+
     fn max(self, other: WorstOverlap) -> WorstOverlap {
         // Ties resolve to the lower particle index so the report does not depend on the thread count.
         if other.ratio > self.ratio || (other.ratio == self.ratio && other.particle < self.particle) {
@@ -328,7 +339,8 @@ impl Context<'_> {
     }
 
     /// Completes particle i once all its pair contributions are in (f, t): its walls, then [`Context::finish`],
-    /// storing the new motion. `wall_base` is the first wall slot of the history view. Returns the final (f, t).
+    /// storing the new motion. `wall_ids` are i's walls, whose history is in `walls` from `first_wall_slot` on.
+    /// Returns the final (f, t).
     #[allow(clippy::too_many_arguments)]
     #[inline(always)]
     fn complete<const WB: bool, const TH: bool>(
@@ -337,21 +349,20 @@ impl Context<'_> {
         mut f: Vec3,
         mut t: Vec3,
         motion: &Cells,
-        list: &NeighborList,
+        wall_ids: &[u16],
         walls: &mut ColumnsMut,
-        wall_base: usize,
+        first_wall_slot: usize,
         tally: &mut Tally,
     ) -> (Vec3, Vec3) {
-        let wall_slots = list.walls_of(i);
         let (xi, vi, wi) = (motion.x(i), motion.v(i), motion.w(i));
         self.walls::<WB, TH>(
             i,
             xi,
             vi,
             wi,
-            &list.wall_partner[wall_slots.clone()],
+            wall_ids,
             walls,
-            wall_slots.start - wall_base,
+            first_wall_slot,
             &mut f,
             &mut t,
             &mut tally.worst,
@@ -585,7 +596,17 @@ fn serial<const WB: bool, const TH: bool>(
                 torque[j] += r.torque_j;
             }
         }
-        let (f, t) = ctx.complete::<WB, TH>(i, force[i], torque[i], &motion, list, &mut walls, 0, &mut tally);
+        let wall_slots = list.walls_of(i);
+        let (f, t) = ctx.complete::<WB, TH>(
+            i,
+            force[i],
+            torque[i],
+            &motion,
+            &list.wall_partner[wall_slots.clone()],
+            &mut walls,
+            wall_slots.start,
+            &mut tally,
+        );
         force[i] = f;
         torque[i] = t;
     }
@@ -858,6 +879,42 @@ fn parallel<const WB: bool, const TH: bool>(
     }
 }
 
+/// The neighbour list of particles lo..hi, with particle and slot indices relative to the range (as its history
+/// views are); partner indices stay global.
+struct ListWindow<'a> {
+    start: &'a [u32],
+    pair_base: usize,
+    partner: &'a [u32],
+    wall_start: &'a [u32],
+    wall_base: usize,
+    wall_partner: &'a [u16],
+}
+
+impl<'a> ListWindow<'a> {
+    fn new(list: &'a NeighborList, lo: usize, hi: usize) -> Self {
+        let (pair_base, pair_end) = (list.start[lo] as usize, list.start[hi] as usize);
+        let (wall_base, wall_end) = (list.wall_start[lo] as usize, list.wall_start[hi] as usize);
+        ListWindow {
+            start: &list.start[lo..=hi],
+            pair_base,
+            partner: &list.partner[pair_base..pair_end],
+            wall_start: &list.wall_start[lo..=hi],
+            wall_base,
+            wall_partner: &list.wall_partner[wall_base..wall_end],
+        }
+    }
+
+    #[inline(always)]
+    fn pairs_of(&self, il: usize) -> std::ops::Range<usize> {
+        self.start[il] as usize - self.pair_base..self.start[il + 1] as usize - self.pair_base
+    }
+
+    #[inline(always)]
+    fn walls_of(&self, il: usize) -> std::ops::Range<usize> {
+        self.wall_start[il] as usize - self.wall_base..self.wall_start[il + 1] as usize - self.wall_base
+    }
+}
+
 /// What every range of phase B reads besides its own slices.
 struct RangeData<'a> {
     ctx: &'a Context<'a>,
@@ -894,19 +951,23 @@ fn range_sweep<const WB: bool, const TH: bool>(
     mut pairs: ColumnsMut,
     mut walls: ColumnsMut,
 ) -> (WorstOverlap, Option<usize>, f64) {
+    let (plan, list, buffers) = (range.plan, range.list, range.buffers);
+    let (lo, hi) = (plan.bounds[r], plan.bounds[r + 1]);
+    // Everything below is indexed relative to the range: particle il is lo + il, pair slot k is pair_base + k.
+    let outer = range.ctx;
     let ctx = Context {
         config,
         law,
         table,
-        radius_m,
-        mass_kg,
-        species,
-        ..*range.ctx
+        radius_m: &radius_m[lo..hi],
+        mass_kg: &mass_kg[lo..hi],
+        species: &species[lo..hi],
+        inv_mass_per_kg: &outer.inv_mass_per_kg[lo..hi],
+        inv_inertia_per_kg_m2: &outer.inv_inertia_per_kg_m2[lo..hi],
+        reference: outer.reference.get(lo..hi).unwrap_or(&[]),
+        ..*outer
     };
-    let (plan, list, buffers) = (range.plan, range.list, range.buffers);
-    let (lo, hi) = (plan.bounds[r], plan.bounds[r + 1]);
-    let pair_base = list.start[lo] as usize;
-    let wall_base = list.wall_start[lo] as usize;
+    let window = ListWindow::new(list, lo, hi);
     if !ctx.accumulators_zeroed {
         force.fill(Vec3::zeros());
         torque.fill(Vec3::zeros());
@@ -919,52 +980,56 @@ fn range_sweep<const WB: bool, const TH: bool>(
             torque[j] += buffers.torque_on_j[k];
         }
     }
-    let motion = Cells::new(x, v, w, lo);
+    let motion = Cells::new(x, v, w, 0);
     let mut tally = Tally::default();
-    // The loop body for particle i; `$cross` = whether i may have partners beyond the range. A macro, not a
+    let local_hi = hi - lo;
+    // The loop body for particle il; `$cross` = whether it may have partners beyond the range. A macro, not a
     // closure or a generic function: both made the compiler keep more of the loop's state in memory.
     macro_rules! particle {
-        ($i:expr, $cross:literal) => {{
-            let i: usize = $i;
-            let slots = list.pairs_of(i);
-            let bi = ctx.body(i, &motion);
-            for (k, &j) in slots.clone().zip(&list.partner[slots]) {
-                let j = j as usize;
-                if !$cross || j < hi {
-                    if let Some(res) =
-                        ctx.pair::<WB, TH>(i, &bi, j, &motion, &mut pairs, k - pair_base, &mut tally.worst)
-                    {
-                        force[i - lo] += res.force;
-                        force[j - lo] -= res.force;
-                        torque[i - lo] += res.torque_i;
-                        torque[j - lo] += res.torque_j;
+        ($il:expr, $cross:literal) => {{
+            let il: usize = $il;
+            let slots = window.pairs_of(il);
+            let bi = ctx.body(il, &motion);
+            for (k, &j) in slots.clone().zip(&window.partner[slots]) {
+                let j = j as usize - lo;
+                if !$cross || j < local_hi {
+                    if let Some(res) = ctx.pair::<WB, TH>(il, &bi, j, &motion, &mut pairs, k, &mut tally.worst) {
+                        force[il] += res.force;
+                        force[j] -= res.force;
+                        torque[il] += res.torque_i;
+                        torque[j] += res.torque_j;
                     }
-                } else if buffers.touching[k] {
-                    force[i - lo] += buffers.force_on_i[k];
-                    torque[i - lo] += buffers.torque_on_i[k];
+                } else {
+                    let k = k + window.pair_base;
+                    if buffers.touching[k] {
+                        force[il] += buffers.force_on_i[k];
+                        torque[il] += buffers.torque_on_i[k];
+                    }
                 }
             }
+            let wall_slots = window.walls_of(il);
             let (f, t) = ctx.complete::<WB, TH>(
-                i,
-                force[i - lo],
-                torque[i - lo],
+                il,
+                force[il],
+                torque[il],
                 &motion,
-                list,
+                &window.wall_partner[wall_slots.clone()],
                 &mut walls,
-                wall_base,
+                wall_slots.start,
                 &mut tally,
             );
-            force[i - lo] = f;
-            torque[i - lo] = t;
+            force[il] = f;
+            torque[il] = t;
         }};
     }
-    let cross_from = plan.cross_from[r];
-    for i in lo..cross_from {
-        particle!(i, false);
+    let cross_from = plan.cross_from[r] - lo;
+    for il in 0..cross_from {
+        particle!(il, false);
     }
-    for i in cross_from..hi {
-        particle!(i, true);
+    for il in cross_from..local_hi {
+        particle!(il, true);
     }
+    tally.worst.shift_particles(lo, config.walls.len());
     (
         tally.worst,
         first_non_finite(tally.velocity_sum, v, w, lo),
