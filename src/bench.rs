@@ -20,6 +20,8 @@ pub struct DemBenchOptions {
     pub threads: usize,
     pub steps: u64,
     pub liggghts: bool,
+    /// Also run one thread, interleaved with the `threads` run (see [`run_interleaved`]).
+    pub speedup: bool,
     pub liggghts_input: Option<PathBuf>,
     pub liggghts_binary: PathBuf,
 }
@@ -73,13 +75,75 @@ fn peak_rss_bytes() -> Option<u64> {
     Some(kb * 1024)
 }
 
-/// Runs granflow on the benchmark problem.
-pub fn run_granflow(threads: usize, steps: u64) -> Result<(RunFigures, Simulation)> {
+fn bench_simulation(threads: usize) -> Result<Simulation> {
     let built = scenario::build(
         scenario::parse(BENCH_SCENARIO, Path::new("scenarios/bench-settle.yaml"))?,
         Path::new("scenarios/bench-settle.yaml"),
     )?;
-    let mut sim = Simulation::new(built.config.clone(), built.particles, built.dt_s, built.rng, threads)?;
+    Ok(Simulation::new(
+        built.config.clone(),
+        built.particles,
+        built.dt_s,
+        built.rng,
+        threads,
+    )?)
+}
+
+/// Steps per turn of [`run_interleaved`].
+const INTERLEAVE_STEPS: u64 = 1000;
+
+/// Runs the benchmark on `threads` threads and on one thread in turns of [`INTERLEAVE_STEPS`] steps (the order
+/// alternating from turn to turn), timing each run's turns only. A machine whose speed drifts during the benchmark
+/// (a shared virtual machine's does, by 10 % and more between runs a minute apart) then slows both runs alike,
+/// and their ratio measures the parallel speed-up rather than the drift. Returns the two runs' figures
+/// (`threads` first), the `threads` simulation, and the first difference between the two final states (`None`:
+/// bit-identical, as the engine guarantees for any thread count).
+pub fn run_interleaved(threads: usize, steps: u64) -> Result<(RunFigures, RunFigures, Simulation, Option<String>)> {
+    let mut many = bench_simulation(threads)?;
+    let mut one = bench_simulation(1)?;
+    let mut samples = vec![sample(&many)];
+    let (mut many_s, mut one_s) = (0.0, 0.0);
+    let mut turn = 0u64;
+    while many.step < steps {
+        let chunk = (INTERLEAVE_STEPS - many.step % INTERLEAVE_STEPS).min(steps - many.step);
+        for which in [turn % 2, 1 - turn % 2] {
+            let start = Instant::now();
+            if which == 0 {
+                many.run_steps(chunk)?;
+                many_s += start.elapsed().as_secs_f64();
+            } else {
+                one.run_steps(chunk)?;
+                one_s += start.elapsed().as_secs_f64();
+            }
+        }
+        turn += 1;
+        if many.step % SAMPLE_EVERY == 0 || many.step == steps {
+            samples.push(sample(&many));
+        }
+    }
+    let particles = many.particles.len();
+    let difference = crate::engine::state::first_difference(&many.snapshot(), &one.snapshot());
+    Ok((
+        RunFigures {
+            particles,
+            steps,
+            loop_time_s: many_s,
+            samples,
+        },
+        RunFigures {
+            particles,
+            steps,
+            loop_time_s: one_s,
+            samples: Vec::new(),
+        },
+        many,
+        difference,
+    ))
+}
+
+/// Runs granflow on the benchmark problem.
+pub fn run_granflow(threads: usize, steps: u64) -> Result<(RunFigures, Simulation)> {
+    let mut sim = bench_simulation(threads)?;
     let mut samples = vec![sample(&sim)];
     let start = Instant::now();
     while sim.step < steps {
@@ -224,7 +288,13 @@ fn rel(a: f64, b: f64) -> f64 {
 
 /// Runs the benchmark and prints its report; the last line is `ratio_vs_liggghts: <x>` when LIGGGHTS ran.
 pub fn bench_dem(opts: &DemBenchOptions) -> Result<()> {
-    let (ours, sim) = run_granflow(opts.threads, opts.steps)?;
+    let (ours, sim, one_thread) = if opts.speedup && opts.threads > 1 {
+        let (ours, one, sim, difference) = run_interleaved(opts.threads, opts.steps)?;
+        (ours, sim, Some((one, difference)))
+    } else {
+        let (ours, sim) = run_granflow(opts.threads, opts.steps)?;
+        (ours, sim, None)
+    };
     let heap = sim.heap_bytes();
     println!(
         "granflow: {} particles, {} steps, {} thread(s): loop time {:.2} s, {:.4e} particle-steps/s, {} neighbour-list builds",
@@ -235,6 +305,24 @@ pub fn bench_dem(opts: &DemBenchOptions) -> Result<()> {
         ours.particle_steps_per_s(),
         sim.neighbor_builds()
     );
+    if let Some((one, difference)) = &one_thread {
+        println!(
+            "granflow: the same on 1 thread, interleaved in turns of {INTERLEAVE_STEPS} steps: loop time {:.2} s, {:.4e} particle-steps/s; final states {}",
+            one.loop_time_s,
+            one.particle_steps_per_s(),
+            match difference {
+                None => "bit-identical".to_string(),
+                Some(d) => format!("DIFFER: {d}"),
+            }
+        );
+        println!("speedup_vs_1_thread: {:.3}", one.loop_time_s / ours.loop_time_s);
+        if let Some(d) = difference {
+            return Err(Error::External(format!(
+                "the {}-thread and 1-thread runs ended in different states ({d})",
+                opts.threads
+            )));
+        }
+    }
     let (pair_contacts, wall_contacts) = sim.contact_counts();
     println!(
         "granflow: at the end: {:.2} candidate pairs, {:.2} particle contacts and {:.3} wall contacts per particle",

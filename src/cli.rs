@@ -58,6 +58,10 @@ pub enum BenchCommand {
         /// Also run LIGGGHTS on the reference input in the same invocation and print the ratio.
         #[arg(long)]
         liggghts: bool,
+        /// With --threads N > 1: also run the problem on one thread, interleaved with the N-thread run in chunks of
+        /// 1000 steps so that both see the same machine, and print `speedup_vs_1_thread: <x>`.
+        #[arg(long)]
+        speedup: bool,
         /// The LIGGGHTS input (default: ../shared/bench/liggghts/in.settle, searched upwards from here).
         #[arg(long)]
         liggghts_input: Option<PathBuf>,
@@ -95,6 +99,7 @@ pub fn run(cli: Cli) -> Result<()> {
                     threads,
                     steps,
                     liggghts,
+                    speedup,
                     liggghts_input,
                     liggghts_binary,
                 },
@@ -102,6 +107,7 @@ pub fn run(cli: Cli) -> Result<()> {
             threads,
             steps,
             liggghts,
+            speedup,
             liggghts_input,
             liggghts_binary,
         }),
