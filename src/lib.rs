@@ -4,6 +4,7 @@
 //! `scenario` turns a YAML description of one simulation into the engine's configuration; `checkpoint` writes and
 //! verifies complete HDF5 states; `simulate` and `bench` are the commands built on them.
 
+pub mod analysis;
 pub mod bench;
 pub mod checkpoint;
 pub mod cli;
@@ -12,5 +13,6 @@ pub mod error;
 mod models_doc;
 pub mod scenario;
 pub mod simulate;
+pub mod store;
 
 pub use error::{Error, Result};

@@ -1,0 +1,1 @@
+//! The campaign results database (SQLite).
