@@ -1,13 +1,17 @@
 //! The command line (clap derive). Each subcommand parses into options and calls one library function; no logic
 //! lives here beyond turning arguments into those options.
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 use clap::{Parser, Subcommand};
 
 use crate::bench::{DemBenchOptions, bench_dem};
 use crate::error::Result;
+use crate::campaign::Campaign;
+use crate::inspect::{self, Format};
+use crate::orchestrate::dispatcher::{DispatchOptions, run_campaign};
 use crate::simulate::{SimulateOptions, simulate};
+use crate::worker::{WorkerOptions, run_worker};
 
 #[derive(Debug, Parser)]
 #[command(
@@ -45,6 +49,71 @@ pub enum Command {
     },
     /// List every model name with its parameters and units.
     Models,
+    /// Run a campaign: expand its sweep, run the jobs in worker processes, store their metrics.
+    Run {
+        campaign: PathBuf,
+        /// Campaign directory (default: results/<campaign name>).
+        #[arg(long)]
+        out: Option<PathBuf>,
+        #[command(flatten)]
+        dispatch: DispatchArgs,
+        /// Run even if the directory holds jobs this campaign file no longer produces.
+        #[arg(long)]
+        force: bool,
+    },
+    /// Finish an interrupted campaign (after Ctrl-C, kill -9 or a reboot).
+    Resume {
+        dir: PathBuf,
+        #[command(flatten)]
+        dispatch: DispatchArgs,
+    },
+    /// Jobs by state, running jobs' progress, failures with reasons, ETA.
+    Status { dir: PathBuf },
+    /// Query a campaign's results: a pivot table of one metric over two parameters, or read-only SQL.
+    Query {
+        dir: PathBuf,
+        /// Parameter for the columns and parameter for the rows (a swept path or its unique last key).
+        #[arg(long, num_args = 2, value_names = ["PARAM_X", "PARAM_Y"], conflicts_with = "sql", requires = "metric")]
+        pivot: Option<Vec<String>>,
+        #[arg(long)]
+        metric: Option<String>,
+        /// Any read-only SQL over the tables of schemas/results.sql.
+        #[arg(long)]
+        sql: Option<String>,
+        #[arg(long, value_enum, default_value = "table")]
+        format: Format,
+    },
+    /// Parameters and metrics, one row per job.
+    Export {
+        dir: PathBuf,
+        #[arg(long, value_enum, default_value = "csv")]
+        format: Format,
+    },
+    /// Run one job of a campaign in its directory (started by the dispatcher).
+    #[command(hide = true)]
+    Worker {
+        job_dir: PathBuf,
+        #[arg(long, default_value_t = 1)]
+        threads: usize,
+        /// Exit at once when stdin closes (the dispatcher is gone).
+        #[arg(long)]
+        watch_stdin: bool,
+        #[arg(long)]
+        max_steps: Option<u64>,
+    },
+}
+
+#[derive(Debug, clap::Args)]
+pub struct DispatchArgs {
+    /// Workers at once (default: from the campaign, else cores / threads per job).
+    #[arg(long)]
+    max_parallel: Option<usize>,
+    /// Threads per worker (default: from the campaign).
+    #[arg(long)]
+    threads_per_job: Option<usize>,
+    /// No progress display.
+    #[arg(long)]
+    quiet: bool,
 }
 
 #[derive(Debug, Subcommand)]
@@ -70,8 +139,42 @@ pub enum BenchCommand {
     },
 }
 
-/// Runs the parsed command.
-pub fn run(cli: Cli) -> Result<()> {
+/// Exit code of `run`/`resume` when some jobs failed for good.
+pub const EXIT_JOBS_FAILED: i32 = 6;
+/// Exit code of `run`/`resume` when interrupted (jobs left pending).
+pub const EXIT_INTERRUPTED: i32 = 130;
+
+fn dispatch_campaign(campaign: &Campaign, source: &Path, out: &Path, args: DispatchArgs, force: bool) -> Result<i32> {
+    let outcome = run_campaign(
+        campaign,
+        source,
+        out,
+        &DispatchOptions {
+            max_parallel: args.max_parallel,
+            threads_per_job: args.threads_per_job,
+            quiet: args.quiet,
+            force,
+        },
+    )?;
+    eprintln!(
+        "{}: {} done, {} failed, {} left{}",
+        out.display(),
+        outcome.done,
+        outcome.failed,
+        outcome.pending,
+        if outcome.interrupted { " (interrupted: `granflow resume` finishes)" } else { "" }
+    );
+    Ok(if outcome.interrupted {
+        EXIT_INTERRUPTED
+    } else if outcome.failed > 0 {
+        EXIT_JOBS_FAILED
+    } else {
+        0
+    })
+}
+
+/// Runs the parsed command; returns the process exit code.
+pub fn run(cli: Cli) -> Result<i32> {
     match cli.command {
         Command::Simulate {
             scenario,
@@ -91,7 +194,7 @@ pub fn run(cli: Cli) -> Result<()> {
                 "{}",
                 serde_json::to_string_pretty(&summary).expect("summary serialises")
             );
-            Ok(())
+            Ok(0)
         }
         Command::Bench {
             which:
@@ -110,10 +213,64 @@ pub fn run(cli: Cli) -> Result<()> {
             speedup,
             liggghts_input,
             liggghts_binary,
-        }),
+        })
+        .map(|()| 0),
         Command::Models => {
             print!("{}", crate::models_doc::MODELS);
-            Ok(())
+            Ok(0)
         }
+        Command::Run {
+            campaign,
+            out,
+            dispatch,
+            force,
+        } => {
+            let loaded = crate::campaign::load(&campaign)?;
+            let dir = crate::campaign::output_dir(&loaded.spec, out.as_deref());
+            dispatch_campaign(&loaded, &campaign, &dir, dispatch, force)
+        }
+        Command::Resume { dir, dispatch } => {
+            let loaded = inspect::load_stored_campaign(&dir)?;
+            let source = crate::orchestrate::dispatcher::spec_copy_path(&dir);
+            dispatch_campaign(&loaded, &source, &dir, dispatch, false)
+        }
+        Command::Status { dir } => {
+            print!("{}", inspect::status(&dir)?);
+            Ok(0)
+        }
+        Command::Query {
+            dir,
+            pivot,
+            metric,
+            sql,
+            format,
+        } => {
+            let text = match (pivot, sql) {
+                (Some(axes), None) => inspect::pivot(&dir, &axes[0], &axes[1], metric.as_deref().unwrap_or_default(), format)?,
+                (None, Some(sql)) => inspect::sql(&dir, &sql, format)?,
+                _ => {
+                    return Err(crate::Error::Usage(
+                        "query needs either --pivot <PARAM_X> <PARAM_Y> --metric <NAME> or --sql <QUERY>".into(),
+                    ));
+                }
+            };
+            print!("{text}");
+            Ok(0)
+        }
+        Command::Export { dir, format } => {
+            print!("{}", inspect::export(&dir, format)?);
+            Ok(0)
+        }
+        Command::Worker {
+            job_dir,
+            threads,
+            watch_stdin,
+            max_steps,
+        } => Ok(run_worker(&WorkerOptions {
+            job_dir,
+            threads,
+            watch_stdin,
+            max_steps,
+        })),
     }
 }

@@ -36,13 +36,16 @@ pub enum Error {
     },
     #[error("{0}")]
     External(String),
+    /// A command used wrongly in a way clap cannot express.
+    #[error("{0}")]
+    Usage(String),
 }
 
 impl Error {
     /// The process exit code for this error (see the `EXIT_*` constants).
     pub fn exit_code(&self) -> i32 {
         match self {
-            Error::Config(_) => EXIT_CONFIG,
+            Error::Config(_) | Error::Usage(_) => EXIT_CONFIG,
             Error::Numerical(_) => EXIT_NUMERICAL,
             Error::Checkpoint(_) => EXIT_CHECKPOINT,
             Error::Io { .. } | Error::External(_) => EXIT_IO,

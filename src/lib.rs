@@ -6,13 +6,17 @@
 
 pub mod analysis;
 pub mod bench;
+pub mod campaign;
 pub mod checkpoint;
 pub mod cli;
 pub mod engine;
 pub mod error;
+pub mod inspect;
 mod models_doc;
 pub mod scenario;
 pub mod simulate;
 pub mod store;
+pub mod orchestrate;
+pub mod worker;
 
 pub use error::{Error, Result};

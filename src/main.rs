@@ -2,8 +2,11 @@ use clap::Parser;
 
 fn main() {
     let cli = granflow::cli::Cli::parse();
-    if let Err(e) = granflow::cli::run(cli) {
-        eprintln!("error: {e}");
-        std::process::exit(e.exit_code());
+    match granflow::cli::run(cli) {
+        Ok(code) => std::process::exit(code),
+        Err(e) => {
+            eprintln!("error: {e}");
+            std::process::exit(e.exit_code());
+        }
     }
 }

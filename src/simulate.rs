@@ -7,6 +7,7 @@
 
 use std::io::Write;
 use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Instant;
 
 use crate::checkpoint::{CheckpointMeta, CheckpointSeries};
@@ -35,6 +36,8 @@ pub struct Summary {
     pub dt_s: f64,
     pub dt_over_contact_time: f64,
     pub finished: bool,
+    /// The run was asked to stop (signal) and checkpointed before its end.
+    pub stopped: bool,
     pub kinetic_energy_j: f64,
     pub bed_top_m: f64,
     pub mean_height_m: f64,
@@ -82,17 +85,18 @@ fn series_row(sim: &Simulation) -> String {
 }
 
 /// Keeps the header and the rows up to `step` of an existing series file.
-fn truncate_series(path: &Path, step: u64) -> Result<()> {
+fn truncate_series(path: &Path, header: &str, step: u64) -> Result<()> {
     let text = match std::fs::read_to_string(path) {
         Ok(t) => t,
         Err(e) if e.kind() == std::io::ErrorKind::NotFound => String::new(),
         Err(e) => return Err(Error::io("read", path, e)),
     };
-    let mut out = String::from(SERIES_HEADER);
+    let mut out = String::from(header);
     out.push('\n');
+    let fields = header.split(',').count();
     for line in text.lines().skip(1) {
         // A row cut short by a kill has fewer fields and is dropped.
-        let complete = line.split(',').count() == SERIES_HEADER.split(',').count();
+        let complete = line.split(',').count() == fields;
         match line.split(',').next().and_then(|s| s.parse::<u64>().ok()) {
             Some(s) if s <= step && complete => {
                 out.push_str(line);
@@ -120,8 +124,79 @@ pub fn simulate(opts: &SimulateOptions) -> Result<Summary> {
         .out_dir
         .clone()
         .unwrap_or_else(|| PathBuf::from("results").join(&built.spec.name));
-    let meta = checkpoint_meta(&built);
-    std::fs::create_dir_all(&out).map_err(|e| Error::io("create directory", &out, e))?;
+    let (summary, _) = run_in_dir(
+        &built,
+        &out,
+        RunControl {
+            threads: opts.threads,
+            max_steps: opts.max_steps,
+            quiet: opts.quiet,
+            stop: None,
+            observer: &mut NoObserver,
+        },
+    )?;
+    Ok(summary)
+}
+
+/// What happens during a run, for callers that report it (the campaign worker).
+#[derive(Debug, Clone, Copy)]
+pub enum RunEvent {
+    Started {
+        step: u64,
+        total_steps: u64,
+        resumed_from_step: Option<u64>,
+    },
+    Progress {
+        step: u64,
+        time_s: f64,
+        steps_per_s: f64,
+    },
+    Checkpointed {
+        step: u64,
+    },
+}
+
+/// Hooks into a run: extra series columns and events.
+pub trait RunObserver {
+    /// Names of extra series columns, each preceded by a comma (`",a,b"`), or empty.
+    fn extra_columns(&self) -> String {
+        String::new()
+    }
+    /// Values of the extra columns for the current state, each preceded by a comma.
+    fn extra_row(&mut self, _sim: &Simulation) -> String {
+        String::new()
+    }
+    fn event(&mut self, _event: RunEvent) {}
+}
+
+/// An observer that adds nothing.
+pub struct NoObserver;
+impl RunObserver for NoObserver {}
+
+/// How to run: threads, an optional step budget, and an optional stop flag (set by a signal handler: the run
+/// checkpoints at the next chunk boundary and returns with `finished = false`).
+pub struct RunControl<'a> {
+    pub threads: usize,
+    pub max_steps: Option<u64>,
+    pub quiet: bool,
+    pub stop: Option<&'a AtomicBool>,
+    pub observer: &'a mut dyn RunObserver,
+}
+
+/// Steps between checks of the stop flag and progress reports.
+const CHUNK_STEPS: u64 = 500;
+
+/// Runs (or resumes) a built scenario in `out`. Returns this invocation's summary and the final simulation.
+pub fn run_in_dir(built: &BuiltScenario, out: &Path, ctl: RunControl) -> Result<(Summary, Simulation)> {
+    let RunControl {
+        threads,
+        max_steps,
+        quiet,
+        stop,
+        observer,
+    } = ctl;
+    let meta = checkpoint_meta(built);
+    std::fs::create_dir_all(out).map_err(|e| Error::io("create directory", out, e))?;
     let spec_path = out.join("scenario.json");
     match std::fs::read_to_string(&spec_path) {
         Ok(existing) if existing != meta.scenario_json => {
@@ -135,7 +210,8 @@ pub fn simulate(opts: &SimulateOptions) -> Result<Summary> {
         Err(e) => return Err(Error::io("read", &spec_path, e)),
     }
 
-    let series = CheckpointSeries::new(&out, built.spec.output.keep_checkpoints);
+    let header = format!("{SERIES_HEADER}{}", observer.extra_columns());
+    let series = CheckpointSeries::new(out, built.spec.output.keep_checkpoints);
     let series_path = out.join("series.csv");
     let (mut sim, resumed_from_step) = match series.latest_valid()? {
         Some(loaded) => {
@@ -149,12 +225,12 @@ pub fn simulate(opts: &SimulateOptions) -> Result<Summary> {
                 )));
             }
             let step = loaded.state.step;
-            truncate_series(&series_path, step)?;
-            if !opts.quiet {
+            truncate_series(&series_path, &header, step)?;
+            if !quiet {
                 eprintln!("resuming from {} (step {step})", loaded.path.display());
             }
             (
-                Simulation::restore(built.config.clone(), loaded.state, opts.threads)?,
+                Simulation::restore(built.config.clone(), loaded.state, threads)?,
                 Some(step),
             )
         }
@@ -164,15 +240,17 @@ pub fn simulate(opts: &SimulateOptions) -> Result<Summary> {
                 built.particles.clone(),
                 built.dt_s,
                 built.rng,
-                opts.threads,
+                threads,
             )?;
-            truncate_series(&series_path, 0)?;
-            series.write(&sim.snapshot(), &meta)?;
+            truncate_series(&series_path, &header, 0)?;
+            let row = format!("{}{}", series_row(&sim), observer.extra_row(&sim));
             let mut f = std::fs::OpenOptions::new()
                 .append(true)
                 .open(&series_path)
                 .map_err(|e| Error::io("open", &series_path, e))?;
-            writeln!(f, "{}", series_row(&sim)).map_err(|e| Error::io("write", &series_path, e))?;
+            writeln!(f, "{row}").map_err(|e| Error::io("write", &series_path, e))?;
+            f.flush().map_err(|e| Error::io("write", &series_path, e))?;
+            series.write(&sim.snapshot(), &meta)?;
             (sim, None)
         }
     };
@@ -185,10 +263,14 @@ pub fn simulate(opts: &SimulateOptions) -> Result<Summary> {
     let start = Instant::now();
     let start_step = sim.step;
     let mut last_report = Instant::now();
-    let stop_at = opts
-        .max_steps
-        .map_or(total_steps, |m| (start_step + m).min(total_steps));
-    if !opts.quiet && resumed_from_step.is_none() {
+    let mut last_event = Instant::now();
+    let stop_at = max_steps.map_or(total_steps, |m| (start_step + m).min(total_steps));
+    observer.event(RunEvent::Started {
+        step: sim.step,
+        total_steps,
+        resumed_from_step,
+    });
+    if !quiet && resumed_from_step.is_none() {
         eprintln!(
             "{}: {} particles, dt = {:.3e} s = {:.4} t_c, {} steps to t = {} s, {} thread(s)",
             built.spec.name,
@@ -203,26 +285,43 @@ pub fn simulate(opts: &SimulateOptions) -> Result<Summary> {
     let every = |n: u64, k: u64| (n / k + 1) * k;
     let mut checkpoint_time_s = 0.0;
     let mut checkpoints_written = 0u64;
-    let mut write_checkpoint = |sim: &Simulation| -> Result<()> {
+    let mut write_checkpoint = |sim: &Simulation, observer: &mut dyn RunObserver| -> Result<()> {
         let t = Instant::now();
         series.write(&sim.snapshot(), &meta)?;
         checkpoint_time_s += t.elapsed().as_secs_f64();
         checkpoints_written += 1;
+        observer.event(RunEvent::Checkpointed { step: sim.step });
         Ok(())
     };
+    let stop_requested = || stop.is_some_and(|s| s.load(Ordering::Relaxed));
+    let mut stopped = false;
     while sim.step < stop_at {
+        if stop_requested() {
+            stopped = true;
+            break;
+        }
         let next = every(sim.step, built.spec.output.series_every_steps)
             .min(every(sim.step, built.spec.output.checkpoint_every_steps))
+            .min(every(sim.step, CHUNK_STEPS))
             .min(stop_at);
         sim.run_steps(next - sim.step)?;
         if sim.step % built.spec.output.series_every_steps == 0 {
-            writeln!(series_file, "{}", series_row(&sim)).map_err(|e| Error::io("write", &series_path, e))?;
+            let row = format!("{}{}", series_row(&sim), observer.extra_row(&sim));
+            writeln!(series_file, "{row}").map_err(|e| Error::io("write", &series_path, e))?;
         }
         if sim.step % built.spec.output.checkpoint_every_steps == 0 || sim.step == total_steps {
             series_file.flush().map_err(|e| Error::io("write", &series_path, e))?;
-            write_checkpoint(&sim)?;
+            write_checkpoint(&sim, observer)?;
         }
-        if !opts.quiet && last_report.elapsed().as_secs_f64() > 5.0 {
+        if last_event.elapsed().as_secs_f64() >= 1.0 {
+            last_event = Instant::now();
+            observer.event(RunEvent::Progress {
+                step: sim.step,
+                time_s: sim.time_s,
+                steps_per_s: (sim.step - start_step) as f64 / start.elapsed().as_secs_f64(),
+            });
+        }
+        if !quiet && last_report.elapsed().as_secs_f64() > 5.0 {
             last_report = Instant::now();
             let rate = (sim.step - start_step) as f64 / start.elapsed().as_secs_f64();
             eprintln!(
@@ -236,9 +335,9 @@ pub fn simulate(opts: &SimulateOptions) -> Result<Summary> {
         }
     }
     if sim.step % built.spec.output.checkpoint_every_steps != 0 && sim.step != total_steps {
-        // Stopped early (--max-steps): keep everything computed so far.
+        // Stopped early (--max-steps or a stop request): keep everything computed so far.
         series_file.flush().map_err(|e| Error::io("write", &series_path, e))?;
-        write_checkpoint(&sim)?;
+        write_checkpoint(&sim, observer)?;
     }
     let wall = start.elapsed().as_secs_f64();
     let (top, mean) = sim.bed_height_m();
@@ -250,6 +349,7 @@ pub fn simulate(opts: &SimulateOptions) -> Result<Summary> {
         dt_s: sim.dt_s,
         dt_over_contact_time: sim.dt_s / built.contact_time_s,
         finished: sim.step >= total_steps,
+        stopped,
         kinetic_energy_j: sim.particles.kinetic_energy_j(),
         bed_top_m: top,
         mean_height_m: mean,
@@ -263,5 +363,5 @@ pub fn simulate(opts: &SimulateOptions) -> Result<Summary> {
         let json = serde_json::to_string_pretty(&summary).expect("summary serialises");
         write_atomic(&out.join("summary.json"), json.as_bytes())?;
     }
-    Ok(summary)
+    Ok((summary, sim))
 }

@@ -1,1 +1,20 @@
 //! Analysis: reducers that turn a job's particle states and time series into metrics.
+//!
+//! - `mixing`: intensity of segregation, Lacey index and RSD of a two-species bed (seed 000 eqs 2.77–2.80), and seed
+//!   001's height-based mixing index.
+//! - `fit`: the mixing rate constant from an exponential fit of IS(t) (seed 000 §4.1.3) and the time to a fraction
+//!   of a series' maximum (seed 000 Table 1).
+//! - `granular`: granular temperature (seed 000 eq 3.1) and coordination numbers (seed 002).
+//! - `knn`: the exact k-nearest-neighbour search behind the local concentrations of `mixing`.
+//!
+//! Everything here is a pure function of values passed in: nothing reads checkpoints, the store or the engine's
+//! state directly, and nothing here is called while a simulation steps.
+
+pub mod fit;
+pub mod granular;
+pub mod knn;
+pub mod mixing;
+
+pub use fit::{ExponentialFit, fit_exponential_decay, time_to_fraction_of_max};
+pub use granular::{GranularTemperature, granular_temperature, mean_coordination_number};
+pub use mixing::{MixingState, above_median_height, height_mixing_index, mixing_state};

@@ -87,6 +87,10 @@ impl Checker<'_> {
 pub fn build(spec: ScenarioSpec, path: &Path) -> Result<BuiltScenario, ConfigError> {
     let c = Checker { path };
 
+    if spec.name.trim().is_empty() {
+        return Err(c.fail("name", "expected a non-empty scenario name"));
+    }
+
     if spec.species.is_empty() {
         return Err(c.fail("species", "expected at least one species"));
     }

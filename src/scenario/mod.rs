@@ -35,6 +35,12 @@ pub enum ConfigError {
 
 /// Parses scenario YAML text; `path` is used in messages only.
 pub fn parse(text: &str, path: &Path) -> Result<ScenarioSpec, ConfigError> {
+    parse_yaml(text, path)
+}
+
+/// Parses YAML text into `T` (unknown keys rejected by `T`'s serde attributes); errors carry the file, line and
+/// column, and an unknown key gets a "did you mean" when a known key is close to it.
+pub fn parse_yaml<T: serde::de::DeserializeOwned>(text: &str, path: &Path) -> Result<T, ConfigError> {
     // Enums are written as single-key maps (`normal: { hertz: { restitution: 0.9 } }`), the form the model names
     // take everywhere else, rather than serde_norway's default YAML tags (`!hertz`).
     let de = serde_norway::Deserializer::from_str(text);
@@ -44,9 +50,29 @@ pub fn parse(text: &str, path: &Path) -> Result<ScenarioSpec, ConfigError> {
             path: path.to_path_buf(),
             line,
             column,
-            message: e.to_string(),
+            message: with_suggestion(e.to_string()),
         }
     })
+}
+
+/// Appends "did you mean `x`?" to serde's "unknown field `y`, expected one of `a`, `b`" when one is close.
+pub fn with_suggestion(message: String) -> String {
+    let Some(rest) = message.strip_prefix("unknown field `").or_else(|| {
+        message
+            .find("unknown field `")
+            .map(|i| &message[i + "unknown field `".len()..])
+    }) else {
+        return message;
+    };
+    let Some(end) = rest.find('`') else {
+        return message;
+    };
+    let word = &rest[..end];
+    let known: Vec<&str> = rest[end..].split('`').skip(1).step_by(2).collect();
+    match crate::campaign::sweep::did_you_mean(word, &known) {
+        Some(k) if k != word => format!("{message}; did you mean `{k}`?"),
+        _ => message,
+    }
 }
 
 /// Reads, parses and validates a scenario file.

@@ -10,6 +10,8 @@ use crate::engine::particles::Species;
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct ScenarioSpec {
+    /// Required in a scenario file; in a campaign's `base` the campaign fills it in.
+    #[serde(default)]
     pub name: String,
     pub domain: DomainSpec,
     /// One particle layer, motion in x–y only.

@@ -1,0 +1,66 @@
+//! One job: a fully resolved scenario plus what to reduce from it, and its identity.
+//!
+//! The id is a hash of the canonical JSON of everything that decides the job's results (engine version, resolved
+//! scenario, metrics, analysis settings), so re-running a campaign with added sweep values runs only the new jobs,
+//! and changing a parameter makes a different job instead of overwriting one. Thread counts and the position in the
+//! sweep are not part of it: results are bit-identical for any thread count.
+
+use serde::{Deserialize, Serialize};
+
+use super::spec::AnalysisSpec;
+use crate::scenario::ScenarioSpec;
+
+/// Version of the `job.json` format.
+pub const JOB_FORMAT: u32 = 1;
+
+/// What `job.json` in a job directory holds (written once, before the job first runs).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct JobSpec {
+    pub format: u32,
+    pub job_id: String,
+    pub campaign: String,
+    pub engine_version: String,
+    /// The parameters the sweep set, in sweep order: (path, value).
+    pub params: Vec<(String, serde_json::Value)>,
+    pub scenario: ScenarioSpec,
+    pub metrics: Vec<String>,
+    pub analysis: AnalysisSpec,
+}
+
+impl JobSpec {
+    /// Hash of everything but the id itself: 16 hex digits of XXH3-128 over canonical JSON (keys sorted).
+    pub fn compute_id(&self) -> String {
+        let identity = serde_json::json!({
+            "engine_version": self.engine_version,
+            "campaign": self.campaign,
+            "scenario": self.scenario,
+            "metrics": self.metrics,
+            "analysis": self.analysis,
+        });
+        let canonical = serde_json::to_string(&identity).expect("a job spec serialises");
+        let h = xxhash_rust::xxh3::xxh3_128(canonical.as_bytes());
+        format!("{:016x}", (h >> 64) as u64)
+    }
+
+    /// The sweep parameters as a JSON object (path → value), for the database and reports.
+    pub fn params_json(&self) -> String {
+        let map: serde_json::Map<String, serde_json::Value> = self.params.iter().cloned().collect();
+        serde_json::to_string(&map).expect("params serialise")
+    }
+
+    /// A short description for logs: `a=1, b=x`.
+    pub fn label(&self) -> String {
+        self.params
+            .iter()
+            .map(|(k, v)| format!("{}={}", short_name(k), v))
+            .collect::<Vec<_>>()
+            .join(", ")
+    }
+}
+
+/// The last key of a parameter path (`walls[0].drum.rotation_rpm` → `rotation_rpm`), the name shown in tables.
+pub fn short_name(path: &str) -> &str {
+    let last = path.rsplit('.').next().unwrap_or(path);
+    last
+}

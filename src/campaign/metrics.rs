@@ -1,0 +1,138 @@
+//! The per-job metrics a campaign can ask for: names, units, what they need.
+
+use super::JobSpec;
+use super::spec::CampaignSpec;
+
+/// A metric a worker can reduce from its job.
+#[derive(Debug, Clone, Copy)]
+pub struct MetricInfo {
+    pub name: &'static str,
+    pub unit: &'static str,
+    pub description: &'static str,
+    /// Needs `analysis.mixing_species` (a binary mixture).
+    pub needs_mixing: bool,
+}
+
+pub const METRICS: &[MetricInfo] = &[
+    MetricInfo {
+        name: "kinetic_energy_j",
+        unit: "J",
+        description: "total (translational + rotational) kinetic energy at the end",
+        needs_mixing: false,
+    },
+    MetricInfo {
+        name: "translational_kinetic_energy_j",
+        unit: "J",
+        description: "translational kinetic energy at the end",
+        needs_mixing: false,
+    },
+    MetricInfo {
+        name: "bed_top_m",
+        unit: "m",
+        description: "highest particle centre along -gravity at the end (bed or column height)",
+        needs_mixing: false,
+    },
+    MetricInfo {
+        name: "mean_height_m",
+        unit: "m",
+        description: "mean particle centre height along -gravity at the end",
+        needs_mixing: false,
+    },
+    MetricInfo {
+        name: "coordination_number",
+        unit: "1",
+        description: "mean particle-particle contacts per particle at the end",
+        needs_mixing: false,
+    },
+    MetricInfo {
+        name: "granular_temperature_m2_per_s2",
+        unit: "m2/s2",
+        description: "granular temperature at the end (seed 000 eq. 3.1)",
+        needs_mixing: false,
+    },
+    MetricInfo {
+        name: "intensity_of_segregation",
+        unit: "1",
+        description: "IS at the end: std. dev. of the local volume fraction of the mixing species (seed 000 eqs 2.77-2.78)",
+        needs_mixing: true,
+    },
+    MetricInfo {
+        name: "lacey_index",
+        unit: "1",
+        description: "Lacey mixing index at the end (seed 000 eq. 2.80)",
+        needs_mixing: true,
+    },
+    MetricInfo {
+        name: "mixing_rate_constant_per_s",
+        unit: "1/s",
+        description: "k of an exponential fit to IS(t) (seed 000 §4.1.3)",
+        needs_mixing: true,
+    },
+    MetricInfo {
+        name: "time_to_90pct_max_lacey_s",
+        unit: "s",
+        description: "first time the Lacey index reaches 90 % of its maximum (seed 000 Table 1)",
+        needs_mixing: true,
+    },
+];
+
+pub fn info(name: &str) -> Option<&'static MetricInfo> {
+    METRICS.iter().find(|m| m.name == name)
+}
+
+/// Checks the metric names and the analysis settings they need; errors are (key path, message).
+pub fn check(spec: &CampaignSpec) -> Result<(), (String, String)> {
+    if spec.metrics.is_empty() {
+        return Err(("metrics".into(), "expected at least one metric".into()));
+    }
+    let names: Vec<&str> = METRICS.iter().map(|m| m.name).collect();
+    for (k, name) in spec.metrics.iter().enumerate() {
+        let Some(m) = info(name) else {
+            let hint = super::sweep::did_you_mean(name, &names)
+                .map(|s| format!("did you mean `{s}`? "))
+                .unwrap_or_default();
+            return Err((
+                format!("metrics[{k}]"),
+                format!("unknown metric `{name}`; {hint}known: {}", names.join(", ")),
+            ));
+        };
+        if spec.metrics[..k].contains(name) {
+            return Err((format!("metrics[{k}]"), format!("metric `{name}` is listed twice")));
+        }
+        if m.needs_mixing && spec.analysis.mixing_species.is_none() {
+            return Err((
+                format!("metrics[{k}]"),
+                format!("`{name}` needs `analysis.mixing_species` (which species is A in the binary mixture)"),
+            ));
+        }
+    }
+    if spec.analysis.mixing_neighbours == 0 {
+        return Err(("analysis.mixing_neighbours".into(), "expected at least 1".into()));
+    }
+    if let Some(every) = spec.analysis.mixing_every_steps
+        && (every == 0 || every % spec.base.output.series_every_steps != 0)
+    {
+        return Err((
+            "analysis.mixing_every_steps".into(),
+            format!(
+                "expected a positive multiple of base.output.series_every_steps ({})",
+                spec.base.output.series_every_steps
+            ),
+        ));
+    }
+    Ok(())
+}
+
+/// Checks what depends on the resolved scenario (the mixing species must exist in it).
+pub fn check_job(job: &JobSpec) -> Result<(), (String, String)> {
+    if let Some(a) = &job.analysis.mixing_species
+        && !job.scenario.species.iter().any(|s| &s.name == a)
+    {
+        let known: Vec<&str> = job.scenario.species.iter().map(|s| s.name.as_str()).collect();
+        return Err((
+            "analysis.mixing_species".into(),
+            format!("unknown species `{a}`; the scenario defines {}", known.join(", ")),
+        ));
+    }
+    Ok(())
+}

@@ -1,0 +1,243 @@
+//! Campaigns: a YAML file sweeping parameters of a base scenario, expanded into jobs with stable ids.
+//!
+//! Everything here happens before any job starts and writes nothing: parse (file, line, column), expand the sweep
+//! (key paths), resolve each point against the base scenario and validate the result as a scenario would be, check
+//! the job count, duplicates and the metric names.
+
+pub mod job;
+pub mod metrics;
+pub mod spec;
+pub mod sweep;
+
+use std::collections::HashMap;
+use std::path::{Path, PathBuf};
+
+pub use job::JobSpec;
+pub use spec::CampaignSpec;
+
+use crate::scenario::{self, ConfigError, ScenarioSpec};
+
+/// A parsed, expanded campaign.
+#[derive(Debug, Clone)]
+pub struct Campaign {
+    pub spec: CampaignSpec,
+    /// The campaign file as written (stored in the database, so `resume` needs nothing else).
+    pub yaml: String,
+    /// Jobs in sweep order.
+    pub jobs: Vec<JobSpec>,
+    /// Parameter path → the axis name the sweep gives it (used in the database instead of the path).
+    pub axis_names: std::collections::BTreeMap<String, String>,
+}
+
+impl Campaign {
+    /// A short description of a job for logs and progress: `rotation_rpm=10, fill_top_m=0` (named axes only, when
+    /// the sweep names any).
+    pub fn label(&self, job: &JobSpec) -> String {
+        let named: Vec<String> = job
+            .params
+            .iter()
+            .filter_map(|(k, v)| self.axis_names.get(k).map(|n| format!("{n}={v}")))
+            .collect();
+        if named.is_empty() { job.label() } else { named.join(", ") }
+    }
+
+    /// The name a parameter is stored and queried under.
+    pub fn param_name<'a>(&'a self, path: &'a str) -> &'a str {
+        self.axis_names.get(path).map_or(path, String::as_str)
+    }
+}
+
+fn invalid(path: &Path, key: impl Into<String>, message: impl Into<String>) -> ConfigError {
+    ConfigError::Invalid {
+        path: path.to_path_buf(),
+        key: key.into(),
+        message: message.into(),
+    }
+}
+
+/// Reads and expands a campaign file. Jobs are resolved but not yet validated as scenarios (see [`validate_jobs`]).
+pub fn load(path: &Path) -> Result<Campaign, ConfigError> {
+    let yaml = std::fs::read_to_string(path).map_err(|source| ConfigError::Read {
+        path: path.to_path_buf(),
+        source,
+    })?;
+    from_yaml(&yaml, path)
+}
+
+/// As [`load`], from text (`path` is used in messages).
+pub fn from_yaml(yaml: &str, path: &Path) -> Result<Campaign, ConfigError> {
+    let spec: CampaignSpec = scenario::parse_yaml(yaml, path)?;
+    check_name(&spec.name).map_err(|m| invalid(path, "name", m))?;
+    metrics::check(&spec).map_err(|(key, m)| invalid(path, key, m))?;
+    if spec.checkpoint.every_steps == 0 {
+        return Err(invalid(path, "checkpoint.every_steps", "expected a number of steps > 0"));
+    }
+    if spec.checkpoint.keep == 0 {
+        return Err(invalid(path, "checkpoint.keep", "expected at least 1 checkpoint kept"));
+    }
+    let spec::ExecutorSpec::Local(local) = &spec.executor;
+    if local.threads_per_job == 0 {
+        return Err(invalid(path, "executor.local.threads_per_job", "expected at least 1"));
+    }
+    if local.max_parallel == Some(0) {
+        return Err(invalid(path, "executor.local.max_parallel", "expected at least 1"));
+    }
+    if let Some(t) = local.job_timeout_s
+        && !(t.is_finite() && t > 0.0)
+    {
+        return Err(invalid(path, "executor.local.job_timeout_s", format!("expected a time > 0, got {t}")));
+    }
+    if !(local.heartbeat_timeout_s.is_finite() && local.heartbeat_timeout_s > 0.0) {
+        return Err(invalid(
+            path,
+            "executor.local.heartbeat_timeout_s",
+            format!("expected a time > 0, got {}", local.heartbeat_timeout_s),
+        ));
+    }
+
+    let points = sweep::expand(&spec.sweep, "sweep").map_err(|e| invalid(path, e.key, e.message))?;
+    let names = sweep::axis_names(&spec.sweep);
+    for (k, (p, n)) in names.iter().enumerate() {
+        if names[..k].iter().any(|(p2, n2)| n2 == n && p2 != p) {
+            return Err(invalid(path, "sweep", format!("axis name `{n}` is given to two parameters")));
+        }
+    }
+    if points.len() > spec.max_jobs {
+        return Err(invalid(
+            path,
+            "sweep",
+            format!(
+                "expands into {} jobs, more than max_jobs = {}; raise max_jobs if this is intended",
+                points.len(),
+                spec.max_jobs
+            ),
+        ));
+    }
+    let base = base_document(&spec);
+    let mut jobs = Vec::with_capacity(points.len());
+    let mut seen: HashMap<String, usize> = HashMap::new();
+    for (ordinal, point) in points.into_iter().enumerate() {
+        let job = resolve(&spec, &base, point, ordinal, path)?;
+        if let Some(&first) = seen.get(&job.job_id) {
+            return Err(invalid(
+                path,
+                "sweep",
+                format!(
+                    "points {first} and {ordinal} give the same job ({}); remove the duplicate",
+                    job.label()
+                ),
+            ));
+        }
+        seen.insert(job.job_id.clone(), ordinal);
+        jobs.push(job);
+    }
+    Ok(Campaign {
+        spec,
+        yaml: yaml.to_string(),
+        jobs,
+        axis_names: names.into_iter().collect(),
+    })
+}
+
+fn check_name(name: &str) -> Result<(), String> {
+    if name.is_empty() || !name.chars().all(|c| c.is_ascii_alphanumeric() || "-_.".contains(c)) || name.starts_with('.')
+    {
+        return Err(format!(
+            "expected a name of letters, digits, `-`, `_` and `.` (it names the output directory), got `{name}`"
+        ));
+    }
+    Ok(())
+}
+
+/// The base scenario as a JSON document with every field present (defaults included), the campaign's name and
+/// checkpoint policy filled in.
+fn base_document(spec: &CampaignSpec) -> serde_json::Value {
+    let mut base = spec.base.clone();
+    base.name = spec.name.clone();
+    base.output.checkpoint_every_steps = spec.checkpoint.every_steps;
+    base.output.keep_checkpoints = spec.checkpoint.keep;
+    serde_json::to_value(&base).expect("a scenario serialises")
+}
+
+/// Applies one sweep point to the base and derives the job's seed and id.
+fn resolve(
+    spec: &CampaignSpec,
+    base: &serde_json::Value,
+    point: sweep::Point,
+    ordinal: usize,
+    path: &Path,
+) -> Result<JobSpec, ConfigError> {
+    let mut doc = base.clone();
+    let mut seen_paths: Vec<&str> = Vec::new();
+    for (param, value) in &point {
+        if seen_paths.contains(&param.as_str()) {
+            return Err(invalid(path, "sweep", format!("parameter `{param}` is set twice in one point")));
+        }
+        seen_paths.push(param);
+        if param == "name" {
+            return Err(invalid(path, "sweep", "the scenario name is the campaign's; it cannot be swept"));
+        }
+        sweep::set_path(&mut doc, param, value.clone())
+            .map_err(|m| invalid(path, "sweep", format!("parameter `{param}`: {m}")))?;
+    }
+    let mut scenario: ScenarioSpec = serde_path_to_error::deserialize(&doc).map_err(|e| {
+        let key = e.path().to_string();
+        invalid(
+            path,
+            format!("base.{key}"),
+            format!("{} (at sweep point {ordinal}: {})", e.inner(), describe(&point)),
+        )
+    })?;
+    if !point.iter().any(|(p, _)| p == "seed") {
+        let params = serde_json::to_string(&point).expect("params serialise");
+        let mut bytes = spec.seed.to_le_bytes().to_vec();
+        bytes.extend_from_slice(params.as_bytes());
+        scenario.seed = xxhash_rust::xxh3::xxh3_64(&bytes);
+    }
+    let mut job = JobSpec {
+        format: job::JOB_FORMAT,
+        job_id: String::new(),
+        campaign: spec.name.clone(),
+        engine_version: env!("CARGO_PKG_VERSION").to_string(),
+        params: point,
+        scenario,
+        metrics: spec.metrics.clone(),
+        analysis: spec.analysis.clone(),
+    };
+    job.job_id = job.compute_id();
+    Ok(job)
+}
+
+fn describe(point: &sweep::Point) -> String {
+    point
+        .iter()
+        .map(|(k, v)| format!("{k} = {v}"))
+        .collect::<Vec<_>>()
+        .join(", ")
+}
+
+/// Validates every given job as a scenario (geometry, materials, particles fitting), naming the sweep point of the
+/// first that fails. Builds the particles, so it costs what building the jobs costs.
+pub fn validate_jobs<'a>(jobs: impl IntoIterator<Item = &'a JobSpec>, path: &Path) -> Result<(), ConfigError> {
+    for job in jobs {
+        if let Err(e) = scenario::build(job.scenario.clone(), path) {
+            let point = describe(&job.params);
+            return Err(match e {
+                ConfigError::Invalid { key, message, .. } => {
+                    invalid(path, format!("base.{key}"), format!("{message} (at sweep point {point})"))
+                }
+                other => other,
+            });
+        }
+        metrics::check_job(job).map_err(|(key, m)| {
+            let point = describe(&job.params);
+            invalid(path, key, format!("{m} (at sweep point {point})"))
+        })?;
+    }
+    Ok(())
+}
+
+/// The output directory of a campaign: `--out` if given, else `results/<name>`.
+pub fn output_dir(spec: &CampaignSpec, out: Option<&Path>) -> PathBuf {
+    out.map_or_else(|| PathBuf::from("results").join(&spec.name), Path::to_path_buf)
+}

@@ -1,0 +1,228 @@
+//! The campaign file as the user writes it (YAML, serde, unknown keys rejected): a `base` scenario, a `sweep` over
+//! dotted parameter paths of that scenario, the metrics to reduce, how to run the jobs and what to do when they fail.
+
+use serde::{Deserialize, Serialize};
+
+use crate::scenario::ScenarioSpec;
+
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CampaignSpec {
+    /// Also the default output directory, `results/<name>/`. Letters, digits, `-`, `_` and `.` only.
+    pub name: String,
+    #[serde(default)]
+    pub description: String,
+    /// The scenario every job starts from (the keys of a scenario file; `name` may be left out).
+    pub base: ScenarioSpec,
+    pub sweep: SweepNode,
+    /// Per-job reducers by name (`granflow models` lists them); stored as metrics with units.
+    #[serde(default = "default_metrics")]
+    pub metrics: Vec<String>,
+    /// Settings of the reducers that need them.
+    #[serde(default)]
+    pub analysis: AnalysisSpec,
+    #[serde(default)]
+    pub executor: ExecutorSpec,
+    /// Checkpoint cadence of every job (overrides the base scenario's `output`).
+    #[serde(default)]
+    pub checkpoint: CheckpointPolicy,
+    #[serde(default)]
+    pub retry: RetryPolicy,
+    /// Seeds every job's random generator together with the job's parameters, unless the sweep sets `seed`.
+    #[serde(default)]
+    pub seed: u64,
+    /// Refuse to expand into more jobs than this.
+    #[serde(default = "default_max_jobs")]
+    pub max_jobs: usize,
+}
+
+fn default_metrics() -> Vec<String> {
+    vec![
+        "kinetic_energy_j".into(),
+        "bed_top_m".into(),
+        "mean_height_m".into(),
+        "coordination_number".into(),
+    ]
+}
+
+fn default_max_jobs() -> usize {
+    10_000
+}
+
+/// One node of the sweep tree. Exactly one of the kinds is given:
+/// - an axis: `param` with one of `values`, `linspace`, `logspace`;
+/// - `grid`: the Cartesian product of its children (in order, the last varying fastest);
+/// - `zip`: its children side by side (all of the same length);
+/// - `list`: explicit points, each a map from parameter path to value.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, Default)]
+#[serde(deny_unknown_fields)]
+pub struct SweepNode {
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub param: Option<String>,
+    /// A short name for the axis in the database, queries and exports (default: the parameter path).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub name: Option<String>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub values: Option<Vec<serde_json::Value>>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub linspace: Option<Range>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub logspace: Option<Range>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub grid: Option<Vec<SweepNode>>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub zip: Option<Vec<SweepNode>>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub list: Option<Vec<serde_json::Map<String, serde_json::Value>>>,
+}
+
+/// `num` points from `start` to `stop` inclusive: evenly spaced (`linspace`) or geometrically (`logspace`; `start`
+/// and `stop` are the end values themselves, not their logarithms).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Range {
+    pub start: f64,
+    pub stop: f64,
+    pub num: usize,
+}
+
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct AnalysisSpec {
+    /// Binary mixing: which species is "A" for the intensity of segregation and the Lacey index.
+    #[serde(default)]
+    pub mixing_species: Option<String>,
+    /// Nearest neighbours per sample (seed 000 eqs 2.77–2.78 use 10).
+    #[serde(default = "default_neighbours")]
+    pub mixing_neighbours: usize,
+    /// Mixing state sampled every this many steps (a multiple of the series cadence).
+    #[serde(default)]
+    pub mixing_every_steps: Option<u64>,
+}
+
+fn default_neighbours() -> usize {
+    10
+}
+
+impl Default for AnalysisSpec {
+    fn default() -> Self {
+        AnalysisSpec {
+            mixing_species: None,
+            mixing_neighbours: default_neighbours(),
+            mixing_every_steps: None,
+        }
+    }
+}
+
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case", deny_unknown_fields)]
+pub enum ExecutorSpec {
+    /// Worker processes on this machine.
+    Local(LocalExecutor),
+}
+
+impl Default for ExecutorSpec {
+    fn default() -> Self {
+        ExecutorSpec::Local(LocalExecutor::default())
+    }
+}
+
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct LocalExecutor {
+    /// Workers at once. Default: the number of cores divided by `threads_per_job`.
+    #[serde(default)]
+    pub max_parallel: Option<usize>,
+    #[serde(default = "one")]
+    pub threads_per_job: usize,
+    /// A job running longer than this is stopped and counted as a timeout.
+    #[serde(default)]
+    pub job_timeout_s: Option<f64>,
+    /// A worker silent for longer than this is killed and counted as lost.
+    #[serde(default = "default_heartbeat_timeout")]
+    pub heartbeat_timeout_s: f64,
+}
+
+fn one() -> usize {
+    1
+}
+
+fn default_heartbeat_timeout() -> f64 {
+    60.0
+}
+
+impl Default for LocalExecutor {
+    fn default() -> Self {
+        LocalExecutor {
+            max_parallel: None,
+            threads_per_job: 1,
+            job_timeout_s: None,
+            heartbeat_timeout_s: default_heartbeat_timeout(),
+        }
+    }
+}
+
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CheckpointPolicy {
+    #[serde(default = "default_checkpoint_every")]
+    pub every_steps: u64,
+    #[serde(default = "default_keep")]
+    pub keep: usize,
+}
+
+fn default_checkpoint_every() -> u64 {
+    5000
+}
+fn default_keep() -> usize {
+    2
+}
+
+impl Default for CheckpointPolicy {
+    fn default() -> Self {
+        CheckpointPolicy {
+            every_steps: default_checkpoint_every(),
+            keep: default_keep(),
+        }
+    }
+}
+
+/// Extra attempts allowed per failure class. A configuration error never retries; a preempted job (stopped by a
+/// signal after checkpointing) is requeued without using an attempt.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RetryPolicy {
+    /// Non-finite values, excessive overlap, lost particle.
+    #[serde(default)]
+    pub numerical: u32,
+    /// The worker exited abnormally (panic, I/O failure, unreadable checkpoint).
+    #[serde(default = "two")]
+    pub crash: u32,
+    /// The worker was killed by a signal it did not handle (e.g. `kill -9`, out of memory).
+    #[serde(default = "three")]
+    pub killed: u32,
+    #[serde(default)]
+    pub timeout: u32,
+    /// The worker stopped sending heartbeats.
+    #[serde(default = "two")]
+    pub lost: u32,
+}
+
+fn two() -> u32 {
+    2
+}
+fn three() -> u32 {
+    3
+}
+
+impl Default for RetryPolicy {
+    fn default() -> Self {
+        RetryPolicy {
+            numerical: 0,
+            crash: 2,
+            killed: 3,
+            timeout: 0,
+            lost: 2,
+        }
+    }
+}

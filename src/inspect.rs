@@ -1,0 +1,180 @@
+//! Reading a campaign directory: `status`, `query` and `export`. All of it goes through a read-only connection, so
+//! it is safe while a dispatcher runs.
+
+use std::fs::File;
+use std::path::{Path, PathBuf};
+
+use crate::campaign::{self, Campaign};
+use crate::error::Error;
+use crate::orchestrate::dispatcher::{database_path, spec_copy_path};
+use crate::store::{self, JobStatus, Store};
+
+/// Output formats of `query` and `export`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum Format {
+    Table,
+    Csv,
+    Json,
+}
+
+fn store_err(e: store::StoreError) -> Error {
+    Error::External(e.to_string())
+}
+
+/// The campaign stored in a campaign directory (its copy of the campaign file).
+pub fn load_stored_campaign(dir: &Path) -> Result<Campaign, Error> {
+    let path = spec_copy_path(dir);
+    if !path.exists() {
+        return Err(Error::External(format!(
+            "{} is not a campaign directory (no {})",
+            dir.display(),
+            path.display()
+        )));
+    }
+    Ok(campaign::load(&path)?)
+}
+
+fn open(dir: &Path) -> Result<(Store, i64, Campaign), Error> {
+    let campaign = load_stored_campaign(dir)?;
+    let store = Store::open_read_only(database_path(dir)).map_err(store_err)?;
+    let id = store
+        .campaign_by_name(&campaign.spec.name)
+        .map_err(store_err)?
+        .ok_or_else(|| Error::External(format!("{}: no campaign `{}` in the database", dir.display(), campaign.spec.name)))?
+        .id;
+    Ok((store, id, campaign))
+}
+
+/// Whether a dispatcher holds the campaign's lock right now.
+fn dispatcher_running(dir: &Path) -> bool {
+    match File::open(dir.join("campaign.lock")) {
+        Ok(f) => matches!(f.try_lock_shared(), Err(std::fs::TryLockError::WouldBlock)),
+        Err(_) => false,
+    }
+}
+
+/// `granflow status`: jobs by state, running jobs' progress, failures with reasons, an ETA.
+pub fn status(dir: &Path) -> Result<String, Error> {
+    let (store, id, campaign) = open(dir)?;
+    let rows = store.job_summaries(id).map_err(store_err)?;
+    let count = |s: JobStatus| rows.iter().filter(|r| r.status == s).count();
+    let (pending, running, done, failed) = (
+        count(JobStatus::Pending),
+        count(JobStatus::Running),
+        count(JobStatus::Done),
+        count(JobStatus::Failed),
+    );
+    let mut out = format!(
+        "campaign {} ({}): {} jobs: {done} done, {running} running, {pending} pending, {failed} failed\n",
+        campaign.spec.name,
+        dir.display(),
+        rows.len()
+    );
+    let live = dispatcher_running(dir);
+    out += &format!(
+        "dispatcher: {}\n",
+        if live { "running" } else { "not running (`granflow resume` finishes what is left)" }
+    );
+    let jobs_by_id: std::collections::HashMap<&str, &campaign::JobSpec> =
+        campaign.jobs.iter().map(|j| (j.job_id.as_str(), j)).collect();
+    let label = |id: &str| jobs_by_id.get(id).map(|j| j.label()).unwrap_or_default();
+    for r in rows.iter().filter(|r| r.status == JobStatus::Running) {
+        let end = jobs_by_id.get(r.job_id.as_str()).map_or(f64::NAN, |j| j.scenario.time.end_time_s);
+        out += &format!(
+            "  running {} ({}): t = {:.4} of {} s, attempt {}{}\n",
+            r.job_id,
+            label(&r.job_id),
+            r.sim_time_s.unwrap_or(0.0),
+            end,
+            r.attempt,
+            if live { "" } else { " (stale: no dispatcher)" }
+        );
+    }
+    for r in rows.iter().filter(|r| r.status == JobStatus::Failed) {
+        out += &format!(
+            "  failed {} ({}): {}: {}\n",
+            r.job_id,
+            label(&r.job_id),
+            r.exit_class.as_deref().unwrap_or("unknown"),
+            r.error.as_deref().unwrap_or("")
+        );
+    }
+    let walls: Vec<f64> = rows.iter().filter_map(|r| (r.status == JobStatus::Done).then_some(r.wall_time_s).flatten()).collect();
+    if !walls.is_empty() && pending + running > 0 {
+        let crate::campaign::spec::ExecutorSpec::Local(local) = &campaign.spec.executor;
+        let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
+        let parallel = local.max_parallel.unwrap_or((cores / local.threads_per_job.max(1)).max(1));
+        let mean = walls.iter().sum::<f64>() / walls.len() as f64;
+        out += &format!(
+            "ETA: about {:.0} s ({} jobs left × {:.1} s mean wall time / {} in parallel)\n",
+            mean * (pending + running) as f64 / parallel as f64,
+            pending + running,
+            mean,
+            parallel
+        );
+    }
+    Ok(out)
+}
+
+/// Resolves a user's parameter name to a stored parameter path: the exact path, or the unique path ending in it.
+fn resolve_param(store: &Store, name: &str) -> Result<String, Error> {
+    let (_, rows) = store.query_sql("SELECT DISTINCT name FROM params ORDER BY name").map_err(store_err)?;
+    let names: Vec<String> = rows.iter().filter_map(|r| r[0].as_str().map(str::to_string)).collect();
+    if names.iter().any(|n| n == name) {
+        return Ok(name.to_string());
+    }
+    let matches: Vec<&String> = names
+        .iter()
+        .filter(|n| n.ends_with(&format!(".{name}")) || n.ends_with(&format!("]{name}")))
+        .collect();
+    match matches.as_slice() {
+        [one] => Ok((*one).clone()),
+        [] => Err(Error::External(format!(
+            "no swept parameter `{name}`; the sweep sets: {}",
+            names.join(", ")
+        ))),
+        several => Err(Error::External(format!(
+            "`{name}` is ambiguous: {}",
+            several.iter().map(|s| s.as_str()).collect::<Vec<_>>().join(", ")
+        ))),
+    }
+}
+
+/// `granflow query --pivot X Y --metric M`.
+pub fn pivot(dir: &Path, x: &str, y: &str, metric: &str, format: Format) -> Result<String, Error> {
+    let (store, id, _) = open(dir)?;
+    let (x, y) = (resolve_param(&store, x)?, resolve_param(&store, y)?);
+    let p = store.pivot(id, &x, &y, metric).map_err(store_err)?;
+    Ok(match format {
+        Format::Table => p.to_table(),
+        Format::Csv => p.to_csv(),
+        Format::Json => p.to_json(),
+    })
+}
+
+/// `granflow query --sql`.
+pub fn sql(dir: &Path, query: &str, format: Format) -> Result<String, Error> {
+    let store = Store::open_read_only(database_path(dir)).map_err(store_err)?;
+    let (header, rows) = store.query_sql(query).map_err(store_err)?;
+    Ok(render(&header, &rows, format))
+}
+
+/// `granflow export`: parameters and metrics, one row per job.
+pub fn export(dir: &Path, format: Format) -> Result<String, Error> {
+    let (store, id, _) = open(dir)?;
+    let (header, rows) = store.export_rows(id).map_err(store_err)?;
+    Ok(render(&header, &rows, format))
+}
+
+fn render(header: &[String], rows: &[Vec<serde_json::Value>], format: Format) -> String {
+    match format {
+        Format::Table => store::render_table(header, rows),
+        Format::Csv => store::render_csv(header, rows),
+        Format::Json => store::render_json(header, rows),
+    }
+}
+
+/// The directory `run` uses for a campaign file.
+pub fn run_dir(campaign: &Campaign, out: Option<&Path>) -> PathBuf {
+    campaign::output_dir(&campaign.spec, out)
+}

@@ -1,0 +1,526 @@
+//! The dispatcher: runs a campaign's unfinished jobs as worker processes, at most `max_parallel` at a time, and is
+//! the only writer of the campaign database.
+//!
+//! `run` and `resume` are the same reconciliation: derive the job set from the campaign spec, insert jobs the
+//! database lacks, ingest any `result.json` that finished while nobody was listening, put jobs left `running` by a
+//! dead dispatcher back to `pending`, then work through the pending jobs in sweep order.
+//!
+//! Failure classes and what happens (`RetryPolicy` gives the budgets): config → failed at once; numerical, crash,
+//! killed, timeout, lost → retried from the job's last checkpoint while the class's budget lasts; preempted (the
+//! worker checkpointed and stopped on a signal) → requeued without using an attempt.
+//!
+//! Ctrl-C (SIGINT) or SIGTERM once: no new jobs start, running workers are asked to checkpoint and stop, and the
+//! dispatcher exits when they have; twice: workers are killed at once. Workers are started with `--watch-stdin` on a
+//! pipe only the dispatcher holds, so if the dispatcher dies in any way they stop immediately.
+
+use std::collections::{BTreeMap, HashMap, VecDeque};
+use std::fs::File;
+use std::path::{Path, PathBuf};
+use std::process::Stdio;
+use std::time::{Duration, Instant};
+
+use tokio::io::{AsyncBufReadExt, BufReader};
+use tokio::process::{Child, ChildStdin, Command};
+use tokio::sync::mpsc;
+
+use super::progress::Progress;
+use super::protocol::{Event, Message};
+use crate::campaign::spec::{ExecutorSpec, RetryPolicy};
+use crate::campaign::{self, Campaign, JobSpec};
+use crate::error::Error;
+use crate::simulate::write_atomic;
+use crate::store::{self, AfterFailure, JobStatus, NewJob, ParamValue, Store};
+use crate::worker;
+
+/// How to run a campaign (command-line overrides of the campaign's executor settings).
+#[derive(Debug, Clone, Default)]
+pub struct DispatchOptions {
+    pub max_parallel: Option<usize>,
+    pub threads_per_job: Option<usize>,
+    /// Show progress bars even when stderr is not a terminal (and never when `quiet`).
+    pub quiet: bool,
+    /// Run even though the campaign directory holds jobs that the campaign file no longer produces.
+    pub force: bool,
+}
+
+/// What a dispatcher invocation ended with.
+#[derive(Debug, Clone, Default)]
+pub struct Outcome {
+    pub done: usize,
+    pub failed: usize,
+    pub pending: usize,
+    pub interrupted: bool,
+    /// Jobs whose results were ingested in this invocation.
+    pub ingested: usize,
+}
+
+/// The campaign database of an output directory.
+pub fn database_path(out: &Path) -> PathBuf {
+    out.join("campaign.sqlite")
+}
+
+/// The campaign directory's copy of the campaign file (what `resume` runs).
+pub fn spec_copy_path(out: &Path) -> PathBuf {
+    out.join("campaign.yaml")
+}
+
+/// The directory of one job.
+pub fn job_dir(out: &Path, job_id: &str) -> PathBuf {
+    out.join("jobs").join(job_id)
+}
+
+fn store_err(e: store::StoreError) -> Error {
+    Error::External(e.to_string())
+}
+
+/// Validates, prepares and runs a campaign in `out` to the end (or until interrupted).
+pub fn run_campaign(campaign: &Campaign, source: &Path, out: &Path, opts: &DispatchOptions) -> Result<Outcome, Error> {
+    // Everything that can be wrong with the input is found before anything is written.
+    let unfinished: Vec<&JobSpec> = campaign
+        .jobs
+        .iter()
+        .filter(|j| !job_dir(out, &j.job_id).join("result.json").exists())
+        .collect();
+    campaign::validate_jobs(unfinished.iter().copied(), source)?;
+    if !opts.force {
+        check_no_orphans(campaign, out)?;
+    }
+
+    std::fs::create_dir_all(out.join("jobs")).map_err(|e| Error::io("create directory", out, e))?;
+    let lock_path = out.join("campaign.lock");
+    let lock = File::create(&lock_path).map_err(|e| Error::io("create", &lock_path, e))?;
+    match lock.try_lock() {
+        Ok(()) => {}
+        Err(std::fs::TryLockError::WouldBlock) => {
+            return Err(Error::External(format!(
+                "another dispatcher is running this campaign ({} is locked)",
+                lock_path.display()
+            )));
+        }
+        Err(std::fs::TryLockError::Error(e)) => return Err(Error::io("lock", &lock_path, e)),
+    }
+    let copy = spec_copy_path(out);
+    if std::fs::read_to_string(&copy).ok().as_deref() != Some(campaign.yaml.as_str()) {
+        write_atomic(&copy, campaign.yaml.as_bytes())?;
+    }
+    let _log_guard = super::log::init(&out.join("campaign.log"));
+    tracing::info!(campaign = %campaign.spec.name, jobs = campaign.jobs.len(), "dispatcher started");
+
+    let mut store = Store::open(database_path(out)).map_err(store_err)?;
+    let spec_hash = format!("{:016x}", xxhash_rust::xxh3::xxh3_64(campaign.yaml.as_bytes()));
+    let campaign_id = store
+        .upsert_campaign(&campaign.spec.name, &campaign.yaml, &spec_hash, env!("CARGO_PKG_VERSION"))
+        .map_err(store_err)?;
+    let new_jobs: Vec<NewJob> = campaign
+        .jobs
+        .iter()
+        .enumerate()
+        .map(|(ordinal, j)| NewJob {
+            job_id: j.job_id.clone(),
+            ordinal: ordinal as i64,
+            params_json: j.params_json(),
+            params: j
+                .params
+                .iter()
+                .map(|(k, v)| (campaign.param_name(k).to_string(), param_value(v)))
+                .collect(),
+        })
+        .collect();
+    store.insert_jobs(campaign_id, &new_jobs).map_err(store_err)?;
+    store.reset_running_to_pending(campaign_id).map_err(store_err)?;
+
+    // Job directories and results that arrived while no dispatcher was listening.
+    let rows: HashMap<String, store::JobRow> = store
+        .job_summaries(campaign_id)
+        .map_err(store_err)?
+        .into_iter()
+        .map(|r| (r.job_id.clone(), r))
+        .collect();
+    let mut outcome = Outcome::default();
+    let mut queue = VecDeque::new();
+    for job in &campaign.jobs {
+        let dir = job_dir(out, &job.job_id);
+        let job_json = dir.join("job.json");
+        if !job_json.exists() {
+            std::fs::create_dir_all(&dir).map_err(|e| Error::io("create directory", &dir, e))?;
+            let text = serde_json::to_string_pretty(job).expect("job specs serialise");
+            write_atomic(&job_json, text.as_bytes())?;
+        }
+        let row = rows.get(&job.job_id);
+        let status = row.map_or(JobStatus::Pending, |r| r.status);
+        if status != JobStatus::Done
+            && let Some(result) = worker::read_result(&dir)?
+        {
+            ingest(&mut store, &job.job_id, &result)?;
+            outcome.ingested += 1;
+            continue;
+        }
+        if status == JobStatus::Pending {
+            queue.push_back(job.clone());
+        }
+    }
+
+    let ExecutorSpec::Local(local) = &campaign.spec.executor;
+    let threads = opts.threads_per_job.unwrap_or(local.threads_per_job).max(1);
+    let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
+    let max_parallel = opts
+        .max_parallel
+        .or(local.max_parallel)
+        .unwrap_or((cores / threads).max(1))
+        .max(1);
+    let settings = Settings {
+        out: out.to_path_buf(),
+        threads,
+        max_parallel,
+        retry: campaign.spec.retry.clone(),
+        job_timeout: local.job_timeout_s.map(Duration::from_secs_f64),
+        heartbeat_timeout: Duration::from_secs_f64(local.heartbeat_timeout_s),
+    };
+    let total = campaign.jobs.len();
+    let already_done = store
+        .status_counts(campaign_id)
+        .map_err(store_err)?
+        .get(JobStatus::Done.as_str())
+        .copied()
+        .unwrap_or(0);
+    let progress = Progress::new(total, already_done, opts.quiet);
+    let runtime = tokio::runtime::Builder::new_current_thread()
+        .enable_all()
+        .build()
+        .map_err(|e| Error::External(format!("cannot start the dispatcher's runtime: {e}")))?;
+    let attempts: HashMap<String, u32> = rows.iter().map(|(id, r)| (id.clone(), r.attempt)).collect();
+    let labels: HashMap<String, String> = campaign.jobs.iter().map(|j| (j.job_id.clone(), campaign.label(j))).collect();
+    let interrupted = runtime.block_on(dispatch(&mut store, queue, attempts, &labels, &settings, progress))?;
+
+    let counts = store.status_counts(campaign_id).map_err(store_err)?;
+    let count = |s: JobStatus| counts.get(s.as_str()).copied().unwrap_or(0);
+    outcome.done = count(JobStatus::Done);
+    outcome.failed = count(JobStatus::Failed);
+    outcome.pending = count(JobStatus::Pending) + count(JobStatus::Running);
+    outcome.interrupted = interrupted;
+    tracing::info!(done = outcome.done, failed = outcome.failed, pending = outcome.pending, "dispatcher stopped");
+    Ok(outcome)
+}
+
+/// Refuses a campaign file that no longer produces jobs the directory's database holds: their parameters changed,
+/// and running would silently leave them behind.
+fn check_no_orphans(campaign: &Campaign, out: &Path) -> Result<(), Error> {
+    let db = database_path(out);
+    if !db.exists() {
+        return Ok(());
+    }
+    let store = Store::open_read_only(&db).map_err(store_err)?;
+    let Some(stored) = store.campaign_by_name(&campaign.spec.name).map_err(store_err)? else {
+        return Ok(());
+    };
+    let wanted: std::collections::HashSet<&str> = campaign.jobs.iter().map(|j| j.job_id.as_str()).collect();
+    let orphans: Vec<String> = store
+        .job_summaries(stored.id)
+        .map_err(store_err)?
+        .into_iter()
+        .filter(|r| !wanted.contains(r.job_id.as_str()))
+        .map(|r| r.params_json)
+        .collect();
+    if orphans.is_empty() {
+        return Ok(());
+    }
+    Err(Error::Config(crate::scenario::ConfigError::Invalid {
+        path: spec_copy_path(out),
+        key: "sweep".into(),
+        message: format!(
+            "{} job(s) already in {} are not produced by this campaign file any more (changed parameters make \
+             new jobs), e.g. {}; use another --out, or --force to run anyway and keep the old jobs' results",
+            orphans.len(),
+            out.display(),
+            orphans[0]
+        ),
+    }))
+}
+
+/// A sweep value as stored in the `params` table: numbers as reals, anything else as its JSON text (strings
+/// without quotes).
+fn param_value(v: &serde_json::Value) -> ParamValue {
+    match v {
+        serde_json::Value::Number(n) => n.as_f64().map_or_else(|| ParamValue::Text(n.to_string()), ParamValue::Real),
+        serde_json::Value::String(s) => ParamValue::Text(s.clone()),
+        other => ParamValue::Text(other.to_string()),
+    }
+}
+
+fn ingest(store: &mut Store, job_id: &str, result: &worker::JobResult) -> Result<(), Error> {
+    let stored = store::JobResult {
+        metrics: result
+            .metrics
+            .iter()
+            .map(|m| store::Metric {
+                name: m.name.clone(),
+                value: m.value,
+                unit: m.unit.clone(),
+            })
+            .collect(),
+        timings: result.timings.clone(),
+        sim_time_s: result.sim_time_s,
+        wall_time_s: result.wall_time_s,
+        steps: result.steps,
+        finished_at: store::unix_time_s(),
+    };
+    store.finish_job(job_id, &stored).map_err(store_err)?;
+    tracing::info!(job = job_id, "result ingested");
+    Ok(())
+}
+
+struct Settings {
+    out: PathBuf,
+    threads: usize,
+    max_parallel: usize,
+    retry: RetryPolicy,
+    job_timeout: Option<Duration>,
+    heartbeat_timeout: Duration,
+}
+
+/// A worker the dispatcher started.
+struct Running {
+    job: JobSpec,
+    attempt: u32,
+    child_pid: Option<u32>,
+    /// Held open for the worker's life: closing it tells the worker that the dispatcher is gone.
+    _stdin: Option<ChildStdin>,
+    started: Instant,
+    last_heard: Instant,
+    /// Why the dispatcher stopped it, if it did (timeout, lost, interrupted).
+    stopped_for: Option<&'static str>,
+    last_error: Option<String>,
+}
+
+enum FromWorker {
+    Line(String, Message),
+    Exited(String, Option<i32>),
+}
+
+/// The event loop. Returns whether it was interrupted.
+async fn dispatch(
+    store: &mut Store,
+    mut queue: VecDeque<JobSpec>,
+    mut attempts: HashMap<String, u32>,
+    labels: &HashMap<String, String>,
+    settings: &Settings,
+    mut progress: Progress,
+) -> Result<bool, Error> {
+    let (tx, mut rx) = mpsc::unbounded_channel::<FromWorker>();
+    let mut running: BTreeMap<String, Running> = BTreeMap::new();
+    let mut retries_used: HashMap<(String, &'static str), u32> = HashMap::new();
+    let mut interrupts = 0u32;
+    let mut sigint = tokio::signal::unix::signal(tokio::signal::unix::SignalKind::interrupt())
+        .map_err(|e| Error::External(format!("cannot handle SIGINT: {e}")))?;
+    let mut sigterm = tokio::signal::unix::signal(tokio::signal::unix::SignalKind::terminate())
+        .map_err(|e| Error::External(format!("cannot handle SIGTERM: {e}")))?;
+    let mut tick = tokio::time::interval(Duration::from_millis(250));
+    loop {
+        while interrupts == 0 && running.len() < settings.max_parallel {
+            let Some(job) = queue.pop_front() else { break };
+            let attempt = attempts.get(&job.job_id).copied().unwrap_or(0) + 1;
+            attempts.insert(job.job_id.clone(), attempt);
+            match spawn(&job, settings, tx.clone()) {
+                Ok((child_pid, stdin)) => {
+                    store
+                        .mark_running(&job.job_id, attempt, &hostname(), store::unix_time_s())
+                        .map_err(store_err)?;
+                    let label = labels.get(&job.job_id).cloned().unwrap_or_default();
+                    tracing::info!(job = %job.job_id, attempt, params = %label, "started");
+                    progress.started(&job.job_id, &label);
+                    running.insert(
+                        job.job_id.clone(),
+                        Running {
+                            job,
+                            attempt,
+                            child_pid,
+                            _stdin: stdin,
+                            started: Instant::now(),
+                            last_heard: Instant::now(),
+                            stopped_for: None,
+                            last_error: None,
+                        },
+                    );
+                }
+                Err(e) => return Err(e),
+            }
+        }
+        if running.is_empty() && (queue.is_empty() || interrupts > 0) {
+            break;
+        }
+        tokio::select! {
+            Some(msg) = rx.recv() => match msg {
+                FromWorker::Line(job_id, m) => {
+                    let Some(r) = running.get_mut(&job_id) else { continue };
+                    r.last_heard = Instant::now();
+                    match m.event {
+                        Event::Progress { step, total_steps, time_s, steps_per_s } => {
+                            store.heartbeat(&job_id, time_s, step, store::unix_time_s()).map_err(store_err)?;
+                            progress.progress(&job_id, step, total_steps, time_s, steps_per_s);
+                        }
+                        Event::Started { step, total_steps, resumed_from_step, .. } => {
+                            if let Some(from) = resumed_from_step {
+                                tracing::info!(job = %job_id, from, "resumed from checkpoint");
+                            }
+                            progress.progress(&job_id, step, total_steps, 0.0, 0.0);
+                        }
+                        Event::Failed { class, error } => {
+                            tracing::warn!(job = %job_id, class, error, "worker reported a failure");
+                            r.last_error = Some(error);
+                        }
+                        Event::Checkpointed { .. } | Event::Finished { .. } | Event::Stopped { .. } => {}
+                    }
+                }
+                FromWorker::Exited(job_id, code) => {
+                    let Some(r) = running.remove(&job_id) else { continue };
+                    progress.ended(&job_id);
+                    let dir = job_dir(&settings.out, &job_id);
+                    match worker::read_result(&dir) {
+                        Ok(Some(result)) => {
+                            ingest(store, &job_id, &result)?;
+                            progress.done();
+                            continue;
+                        }
+                        Ok(None) => {}
+                        Err(e) => {
+                            tracing::warn!(job = %job_id, error = %e, "unreadable result");
+                        }
+                    }
+                    let class: &'static str = r.stopped_for.unwrap_or_else(|| worker::exit_class(code));
+                    let error = r.last_error.clone().unwrap_or_else(|| match code {
+                        Some(c) => format!("worker exited with code {c} without a result (see {}/worker.log)", dir.display()),
+                        None => format!("worker was killed by a signal (see {}/worker.log)", dir.display()),
+                    });
+                    let after = match class {
+                        "preempted" | "interrupted" | "locked" => AfterFailure::Retry,
+                        "config" => AfterFailure::Final,
+                        other => {
+                            let used = retries_used.entry((job_id.clone(), other)).or_insert(0);
+                            let budget = budget(&settings.retry, other);
+                            if *used < budget { *used += 1; AfterFailure::Retry } else { AfterFailure::Final }
+                        }
+                    };
+                    store.mark_failed(&job_id, r.attempt, class, &error, store::unix_time_s(), after).map_err(store_err)?;
+                    tracing::warn!(job = %job_id, class, error, retry = matches!(after, AfterFailure::Retry), "attempt ended without a result");
+                    match after {
+                        AfterFailure::Retry if interrupts == 0 => {
+                            if class == "locked" {
+                                // Another worker holds it (a dispatcher that died moments ago): try later.
+                                tokio::time::sleep(Duration::from_millis(200)).await;
+                            }
+                            queue.push_back(r.job);
+                        }
+                        AfterFailure::Retry => {}
+                        AfterFailure::Final => progress.failed(),
+                    }
+                }
+            },
+            _ = sigint.recv() => interrupts += interrupt(&mut running, interrupts, &mut progress),
+            _ = sigterm.recv() => interrupts += interrupt(&mut running, interrupts, &mut progress),
+            _ = tick.tick() => {
+                for r in running.values_mut() {
+                    if r.stopped_for.is_some() { continue; }
+                    if settings.job_timeout.is_some_and(|t| r.started.elapsed() > t) {
+                        tracing::warn!(job = %r.job.job_id, "timeout: asking the worker to checkpoint and stop");
+                        r.stopped_for = Some("timeout");
+                        signal(r.child_pid, nix::sys::signal::Signal::SIGTERM);
+                    } else if r.last_heard.elapsed() > settings.heartbeat_timeout {
+                        tracing::warn!(job = %r.job.job_id, "no heartbeat: killing the worker");
+                        r.stopped_for = Some("lost");
+                        signal(r.child_pid, nix::sys::signal::Signal::SIGKILL);
+                    }
+                }
+                progress.tick();
+            }
+        }
+    }
+    progress.finish();
+    Ok(interrupts > 0)
+}
+
+fn budget(policy: &RetryPolicy, class: &str) -> u32 {
+    match class {
+        "numerical" => policy.numerical,
+        "crash" => policy.crash,
+        "killed" => policy.killed,
+        "timeout" => policy.timeout,
+        "lost" => policy.lost,
+        _ => 0,
+    }
+}
+
+/// First interrupt: stop starting jobs and ask workers to checkpoint and stop; second: kill them.
+fn interrupt(running: &mut BTreeMap<String, Running>, before: u32, progress: &mut Progress) -> u32 {
+    if before == 0 {
+        progress.message("interrupted: workers are checkpointing and stopping (Ctrl-C again to kill them)");
+        tracing::warn!("interrupted: stopping workers");
+        for r in running.values_mut() {
+            r.stopped_for = Some("interrupted");
+            signal(r.child_pid, nix::sys::signal::Signal::SIGTERM);
+        }
+    } else {
+        progress.message("interrupted again: killing workers");
+        tracing::warn!("interrupted again: killing workers");
+        for r in running.values() {
+            signal(r.child_pid, nix::sys::signal::Signal::SIGKILL);
+        }
+    }
+    1
+}
+
+fn signal(pid: Option<u32>, sig: nix::sys::signal::Signal) {
+    if let Some(pid) = pid {
+        // The worker may already have exited; its exit is handled when its pipe closes.
+        let _ = nix::sys::signal::kill(nix::unistd::Pid::from_raw(pid as i32), sig);
+    }
+}
+
+fn hostname() -> String {
+    nix::unistd::gethostname()
+        .ok()
+        .and_then(|h| h.into_string().ok())
+        .unwrap_or_else(|| "localhost".to_string())
+}
+
+/// Starts `granflow worker <dir>` and a task that forwards its messages and its exit.
+fn spawn(
+    job: &JobSpec,
+    settings: &Settings,
+    tx: mpsc::UnboundedSender<FromWorker>,
+) -> Result<(Option<u32>, Option<ChildStdin>), Error> {
+    let dir = job_dir(&settings.out, &job.job_id);
+    let exe = std::env::current_exe().map_err(|e| Error::External(format!("cannot find the granflow binary: {e}")))?;
+    let log_path = dir.join("worker.log");
+    let log = std::fs::OpenOptions::new()
+        .create(true)
+        .append(true)
+        .open(&log_path)
+        .map_err(|e| Error::io("open", &log_path, e))?;
+    let mut child: Child = Command::new(exe)
+        .arg("worker")
+        .arg(&dir)
+        .arg("--threads")
+        .arg(settings.threads.to_string())
+        .arg("--watch-stdin")
+        .stdin(Stdio::piped())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::from(log))
+        .kill_on_drop(true)
+        .spawn()
+        .map_err(|e| Error::External(format!("cannot start a worker for {}: {e}", dir.display())))?;
+    let pid = child.id();
+    let stdin = child.stdin.take();
+    let stdout = child.stdout.take().expect("stdout is piped");
+    let job_id = job.job_id.clone();
+    tokio::spawn(async move {
+        let mut lines = BufReader::new(stdout).lines();
+        while let Ok(Some(line)) = lines.next_line().await {
+            if let Some(m) = Message::parse(&line) {
+                let _ = tx.send(FromWorker::Line(job_id.clone(), m));
+            }
+        }
+        let code = child.wait().await.ok().and_then(|s| s.code());
+        let _ = tx.send(FromWorker::Exited(job_id, code));
+    });
+    Ok((pid, stdin))
+}

@@ -1,0 +1,275 @@
+//! `granflow worker <job-dir>`: runs one campaign job in its directory.
+//!
+//! The worker owns the directory and never touches the database. It takes the directory's lock (two workers never
+//! run one job), resumes from the newest valid checkpoint if there is one, runs to the end with checkpoints at the
+//! campaign's cadence, reduces the metrics, writes `series.h5` and finally `result.json` (atomically, last: its
+//! presence means done). It reports on stdout in JSON lines (`orchestrate::protocol`).
+//!
+//! Stopping: SIGTERM or SIGINT make it checkpoint at the next chunk boundary and exit with `EXIT_PREEMPTED`. With
+//! `--watch-stdin` (how the dispatcher starts it) it exits at once with `EXIT_ORPHANED` when its stdin closes, which
+//! happens when the dispatcher dies, even by `kill -9`; whatever it computed since its last checkpoint is lost, and
+//! nothing is corrupted, since every file it writes is written to a temporary name and renamed.
+
+mod reduce;
+mod series_h5;
+
+use std::fs::File;
+use std::io::{Read, Write};
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+use std::sync::atomic::AtomicBool;
+use std::time::Instant;
+
+use serde::{Deserialize, Serialize};
+
+use crate::campaign::JobSpec;
+use crate::error::{EXIT_CONFIG, EXIT_IO, EXIT_NUMERICAL, Error};
+use crate::orchestrate::protocol::{EXIT_LOCKED, EXIT_ORPHANED, EXIT_PREEMPTED, Event, Message};
+use crate::simulate::{RunControl, RunEvent, RunObserver, run_in_dir, write_atomic};
+
+pub use reduce::Metric;
+
+/// Format version of `result.json`.
+pub const RESULT_FORMAT: u32 = 1;
+
+/// What `result.json` holds.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct JobResult {
+    pub format: u32,
+    pub job_id: String,
+    pub metrics: Vec<Metric>,
+    /// Seconds per stage of the last invocation: `simulate`, `checkpoint` (part of simulate), `reduce`.
+    pub timings: Vec<(String, f64)>,
+    pub steps: u64,
+    pub sim_time_s: f64,
+    /// Wall time of the invocation that finished the job (earlier attempts are in the database).
+    pub wall_time_s: f64,
+}
+
+/// Options of one worker invocation.
+#[derive(Debug, Clone)]
+pub struct WorkerOptions {
+    pub job_dir: PathBuf,
+    pub threads: usize,
+    pub watch_stdin: bool,
+    /// Stop (with a checkpoint) after this many steps in this invocation; for tests.
+    pub max_steps: Option<u64>,
+}
+
+fn emit(event: Event) {
+    let mut out = std::io::stdout().lock();
+    // A closed stdout means the dispatcher is gone; the stdin watcher ends the process.
+    let _ = writeln!(out, "{}", Message::new(event).to_line());
+    let _ = out.flush();
+}
+
+/// Runs the job and returns the process exit code.
+pub fn run_worker(opts: &WorkerOptions) -> i32 {
+    match run(opts) {
+        Ok(code) => code,
+        Err(e) => {
+            let class = match &e {
+                Error::Config(_) => "config",
+                Error::Numerical(_) => "numerical",
+                _ => "crash",
+            };
+            emit(Event::Failed {
+                class: class.into(),
+                error: e.to_string(),
+            });
+            eprintln!("error: {e}");
+            e.exit_code()
+        }
+    }
+}
+
+fn run(opts: &WorkerOptions) -> Result<i32, Error> {
+    let dir = &opts.job_dir;
+    let lock_path = dir.join("worker.lock");
+    let lock = File::create(&lock_path).map_err(|e| Error::io("create", &lock_path, e))?;
+    match lock.try_lock() {
+        Ok(()) => {}
+        Err(std::fs::TryLockError::WouldBlock) => {
+            let msg = format!("{} is locked by another worker", dir.display());
+            emit(Event::Failed {
+                class: "locked".into(),
+                error: msg.clone(),
+            });
+            eprintln!("error: {msg}");
+            return Ok(EXIT_LOCKED);
+        }
+        Err(std::fs::TryLockError::Error(e)) => return Err(Error::io("lock", &lock_path, e)),
+    }
+    if opts.watch_stdin {
+        std::thread::spawn(|| {
+            let mut buf = [0u8; 64];
+            let mut stdin = std::io::stdin();
+            // Anything the dispatcher writes is ignored; end of file (or an error) means it is gone.
+            while let Ok(n) = stdin.read(&mut buf) {
+                if n == 0 {
+                    break;
+                }
+            }
+            std::process::exit(EXIT_ORPHANED);
+        });
+    }
+    let stop = Arc::new(AtomicBool::new(false));
+    for signal in [signal_hook::consts::SIGTERM, signal_hook::consts::SIGINT] {
+        signal_hook::flag::register(signal, Arc::clone(&stop)).map_err(|e| Error::io("install handler", dir, e))?;
+    }
+
+    let job = read_job(dir)?;
+    let result_path = dir.join("result.json");
+    if result_path.exists() {
+        emit(Event::Finished { wall_time_s: 0.0 });
+        return Ok(0);
+    }
+    let built = crate::scenario::build(job.scenario.clone(), &dir.join("job.json"))?;
+    let start = Instant::now();
+    let mut observer = WorkerObserver::new(&job, &built)?;
+    let (summary, sim) = run_in_dir(
+        &built,
+        dir,
+        RunControl {
+            threads: opts.threads,
+            max_steps: opts.max_steps,
+            quiet: true,
+            stop: Some(&stop),
+            observer: &mut observer,
+        },
+    )?;
+    if !summary.finished {
+        emit(Event::Stopped { step: summary.step });
+        return Ok(if summary.stopped { EXIT_PREEMPTED } else { 0 });
+    }
+    let simulate_s = start.elapsed().as_secs_f64();
+    let t_reduce = Instant::now();
+    let series = reduce::Series::read(&dir.join("series.csv"))?;
+    let metrics = reduce::metrics(&job, &built, &sim, &series)?;
+    series_h5::write(&dir.join("series.h5"), &series)?;
+    let reduce_s = t_reduce.elapsed().as_secs_f64();
+    let result = JobResult {
+        format: RESULT_FORMAT,
+        job_id: job.job_id.clone(),
+        metrics,
+        timings: vec![
+            ("simulate".into(), simulate_s),
+            ("checkpoint".into(), summary.checkpoint_time_s),
+            ("reduce".into(), reduce_s),
+        ],
+        steps: sim.step,
+        sim_time_s: sim.time_s,
+        wall_time_s: start.elapsed().as_secs_f64(),
+    };
+    let json = serde_json::to_string_pretty(&result).expect("results serialise");
+    write_atomic(&result_path, json.as_bytes())?;
+    emit(Event::Finished {
+        wall_time_s: result.wall_time_s,
+    });
+    Ok(0)
+}
+
+/// Reads and checks `job.json` (its id must match its content).
+pub fn read_job(dir: &Path) -> Result<JobSpec, Error> {
+    let path = dir.join("job.json");
+    let text = std::fs::read_to_string(&path).map_err(|e| Error::io("read", &path, e))?;
+    let job: JobSpec = serde_json::from_str(&text)
+        .map_err(|e| Error::External(format!("{}: not a job description: {e}", path.display())))?;
+    if job.compute_id() != job.job_id {
+        return Err(Error::External(format!(
+            "{}: its content does not match its job id {} (edited by hand, or written by another engine version)",
+            path.display(),
+            job.job_id
+        )));
+    }
+    Ok(job)
+}
+
+/// Reads `result.json` of a job directory, if it is there and well formed.
+pub fn read_result(dir: &Path) -> Result<Option<JobResult>, Error> {
+    let path = dir.join("result.json");
+    match std::fs::read_to_string(&path) {
+        Ok(text) => serde_json::from_str(&text)
+            .map(Some)
+            .map_err(|e| Error::External(format!("{}: not a job result: {e}", path.display()))),
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => Ok(None),
+        Err(e) => Err(Error::io("read", &path, e)),
+    }
+}
+
+/// Reports run events on stdout and adds the mixing columns to the series.
+struct WorkerObserver {
+    job_id: String,
+    total_steps: u64,
+    mixing: Option<reduce::MixingSampler>,
+}
+
+impl WorkerObserver {
+    fn new(job: &JobSpec, built: &crate::scenario::BuiltScenario) -> Result<Self, Error> {
+        Ok(WorkerObserver {
+            job_id: job.job_id.clone(),
+            total_steps: 0,
+            mixing: reduce::MixingSampler::new(job, built),
+        })
+    }
+}
+
+impl RunObserver for WorkerObserver {
+    fn extra_columns(&self) -> String {
+        match &self.mixing {
+            Some(_) => reduce::MIXING_COLUMNS.to_string(),
+            None => String::new(),
+        }
+    }
+
+    fn extra_row(&mut self, sim: &crate::engine::Simulation) -> String {
+        match &mut self.mixing {
+            Some(m) => m.row(sim),
+            None => String::new(),
+        }
+    }
+
+    fn event(&mut self, event: RunEvent) {
+        match event {
+            RunEvent::Started {
+                step,
+                total_steps,
+                resumed_from_step,
+            } => {
+                self.total_steps = total_steps;
+                emit(Event::Started {
+                    job_id: self.job_id.clone(),
+                    step,
+                    total_steps,
+                    resumed_from_step,
+                    pid: std::process::id(),
+                });
+            }
+            RunEvent::Progress {
+                step,
+                time_s,
+                steps_per_s,
+            } => emit(Event::Progress {
+                step,
+                total_steps: self.total_steps,
+                time_s,
+                steps_per_s,
+            }),
+            RunEvent::Checkpointed { step } => emit(Event::Checkpointed { step }),
+        }
+    }
+}
+
+/// Exit code → failure class, for a worker that ended without a result.
+pub fn exit_class(code: Option<i32>) -> &'static str {
+    match code {
+        Some(EXIT_CONFIG) => "config",
+        Some(EXIT_NUMERICAL) => "numerical",
+        Some(EXIT_PREEMPTED) => "preempted",
+        Some(EXIT_LOCKED) => "locked",
+        Some(EXIT_ORPHANED) => "killed",
+        Some(EXIT_IO) => "crash",
+        Some(_) => "crash",
+        None => "killed",
+    }
+}

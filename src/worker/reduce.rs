@@ -1,0 +1,204 @@
+//! The per-job reducers: final-state metrics from the simulation, time-series metrics from `series.csv`.
+
+use std::path::Path;
+
+use serde::{Deserialize, Serialize};
+
+use crate::analysis;
+use crate::campaign::JobSpec;
+use crate::campaign::metrics::info;
+use crate::engine::Simulation;
+use crate::engine::particles::SpeciesId;
+use crate::error::Error;
+use crate::scenario::BuiltScenario;
+
+/// One reduced number with its unit.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Metric {
+    pub name: String,
+    /// NaN when the reducer has nothing to say (e.g. no decay to fit); written as `null` in JSON.
+    #[serde(serialize_with = "nan_as_null", deserialize_with = "null_as_nan")]
+    pub value: f64,
+    pub unit: String,
+}
+
+fn nan_as_null<S: serde::Serializer>(v: &f64, s: S) -> Result<S::Ok, S::Error> {
+    if v.is_finite() { s.serialize_f64(*v) } else { s.serialize_none() }
+}
+
+fn null_as_nan<'de, D: serde::Deserializer<'de>>(d: D) -> Result<f64, D::Error> {
+    Ok(Option::<f64>::deserialize(d)?.unwrap_or(f64::NAN))
+}
+
+/// Series columns the mixing sampler adds.
+pub const MIXING_COLUMNS: &str = ",intensity_of_segregation,lacey_index";
+
+/// Samples the mixing state of a binary mixture into the series.
+pub struct MixingSampler {
+    species_a: SpeciesId,
+    neighbours: usize,
+    every_steps: Option<u64>,
+}
+
+impl MixingSampler {
+    pub fn new(job: &JobSpec, built: &BuiltScenario) -> Option<Self> {
+        let name = job.analysis.mixing_species.as_deref()?;
+        Some(MixingSampler {
+            species_a: built.config.species.find(name)?,
+            neighbours: job.analysis.mixing_neighbours,
+            every_steps: job.analysis.mixing_every_steps,
+        })
+    }
+
+    fn state(&self, sim: &Simulation) -> analysis::mixing::MixingState {
+        let p = &sim.particles;
+        let volumes: Vec<f64> = p
+            .radius_m
+            .iter()
+            .map(|r| 4.0 / 3.0 * std::f64::consts::PI * r * r * r)
+            .collect();
+        let is_a: Vec<bool> = p.species.iter().map(|&s| s == self.species_a).collect();
+        analysis::mixing::mixing_state(&p.position_m, &volumes, &is_a, self.neighbours)
+    }
+
+    /// The extra series columns for the current state (`nan` between mixing samples).
+    pub fn row(&mut self, sim: &Simulation) -> String {
+        if self.every_steps.is_some_and(|k| sim.step % k != 0) {
+            return ",nan,nan".to_string();
+        }
+        let m = self.state(sim);
+        format!(",{:e},{:e}", m.intensity_of_segregation, m.lacey_index)
+    }
+}
+
+/// The time series of a job as columns.
+#[derive(Debug, Clone)]
+pub struct Series {
+    pub names: Vec<String>,
+    pub columns: Vec<Vec<f64>>,
+}
+
+impl Series {
+    pub fn read(path: &Path) -> Result<Series, Error> {
+        let text = std::fs::read_to_string(path).map_err(|e| Error::io("read", path, e))?;
+        let mut lines = text.lines();
+        let names: Vec<String> = lines
+            .next()
+            .ok_or_else(|| Error::External(format!("{}: empty series", path.display())))?
+            .split(',')
+            .map(str::to_string)
+            .collect();
+        let mut columns = vec![Vec::new(); names.len()];
+        for (k, line) in lines.enumerate() {
+            let fields: Vec<&str> = line.split(',').collect();
+            if fields.len() != names.len() {
+                return Err(Error::External(format!(
+                    "{}: row {} has {} fields, expected {}",
+                    path.display(),
+                    k + 2,
+                    fields.len(),
+                    names.len()
+                )));
+            }
+            for (c, f) in fields.iter().enumerate() {
+                let v = f.parse::<f64>().map_err(|_| {
+                    Error::External(format!("{}: row {}: `{f}` is not a number", path.display(), k + 2))
+                })?;
+                columns[c].push(v);
+            }
+        }
+        Ok(Series { names, columns })
+    }
+
+    pub fn column(&self, name: &str) -> Option<&[f64]> {
+        self.names
+            .iter()
+            .position(|n| n == name)
+            .map(|k| self.columns[k].as_slice())
+    }
+
+    /// The unit of a series column (from its name's suffix).
+    pub fn unit_of(name: &str) -> &'static str {
+        if name.ends_with("_j") {
+            "J"
+        } else if name.ends_with("_m") {
+            "m"
+        } else if name.ends_with("_s") {
+            "s"
+        } else if name == "step" || name.ends_with("contacts") {
+            "count"
+        } else {
+            "1"
+        }
+    }
+}
+
+/// Every metric the job asks for.
+pub fn metrics(job: &JobSpec, built: &BuiltScenario, sim: &Simulation, series: &Series) -> Result<Vec<Metric>, Error> {
+    let sampler = MixingSampler::new(job, built);
+    let mixing_final = sampler.as_ref().map(|s| s.state(sim));
+    // (t, IS, Lacey) at the sampled rows.
+    let mixing_series = || -> Option<(Vec<f64>, Vec<f64>, Vec<f64>)> {
+        let t = series.column("time_s")?;
+        let is = series.column("intensity_of_segregation")?;
+        let lacey = series.column("lacey_index")?;
+        let rows: Vec<usize> = (0..t.len()).filter(|&k| is[k].is_finite()).collect();
+        Some((
+            rows.iter().map(|&k| t[k]).collect(),
+            rows.iter().map(|&k| is[k]).collect(),
+            rows.iter().map(|&k| lacey[k]).collect(),
+        ))
+    };
+    let mut out = Vec::new();
+    for name in &job.metrics {
+        let meta = info(name).ok_or_else(|| Error::External(format!("unknown metric `{name}`")))?;
+        let value = match name.as_str() {
+            "kinetic_energy_j" => sim.particles.kinetic_energy_j(),
+            "translational_kinetic_energy_j" => sim.particles.translational_kinetic_energy_j(),
+            "bed_top_m" => sim.bed_height_m().0,
+            "mean_height_m" => sim.bed_height_m().1,
+            "coordination_number" => {
+                let (pairs, _) = sim.contact_counts();
+                analysis::mean_coordination_number(sim.particles.len(), pairs)
+            }
+            "granular_temperature_m2_per_s2" => layered_granular_temperature(sim),
+            "intensity_of_segregation" => mixing_final.as_ref().map_or(f64::NAN, |m| m.intensity_of_segregation),
+            "lacey_index" => mixing_final.as_ref().map_or(f64::NAN, |m| m.lacey_index),
+            "mixing_rate_constant_per_s" => mixing_series()
+                .and_then(|(t, is, _)| analysis::fit::fit_exponential_decay(&t, &is))
+                .map_or(f64::NAN, |f| f.rate_constant_per_s),
+            "time_to_90pct_max_lacey_s" => mixing_series()
+                .and_then(|(t, _, lacey)| analysis::fit::time_to_fraction_of_max(&t, &lacey, 0.9))
+                .map_or(f64::NAN, |t| t),
+            other => return Err(Error::External(format!("metric `{other}` has no reducer"))),
+        };
+        out.push(Metric {
+            name: name.clone(),
+            value,
+            unit: meta.unit.to_string(),
+        });
+    }
+    Ok(out)
+}
+
+/// Granular temperature (seed 000 eq 3.1) about the mean velocity of layers normal to gravity, each two particle
+/// diameters thick (the seed's "local mean velocities in the shear layer"); with no gravity, about the bed's mean.
+fn layered_granular_temperature(sim: &Simulation) -> f64 {
+    let p = &sim.particles;
+    if p.is_empty() {
+        return f64::NAN;
+    }
+    let g = sim.config.gravity.at(sim.time_s);
+    let axis = (0..3)
+        .max_by(|&a, &b| g[a].abs().total_cmp(&g[b].abs()))
+        .expect("three axes");
+    let (bins, count) = if g.norm() == 0.0 {
+        (vec![Some(0); p.len()], 1)
+    } else {
+        let lo = p.position_m.iter().map(|x| x[axis]).fold(f64::INFINITY, f64::min);
+        let hi = p.position_m.iter().map(|x| x[axis]).fold(f64::NEG_INFINITY, f64::max);
+        let layers = (((hi - lo) / (4.0 * p.max_radius_m())).ceil() as usize).max(1);
+        (analysis::granular::layer_bins(&p.position_m, axis, lo, hi, layers), layers)
+    };
+    analysis::granular_temperature(&p.velocity_m_per_s, &bins, count).mean_m2_per_s2
+}

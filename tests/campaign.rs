@@ -1,0 +1,203 @@
+//! Campaigns through the real binary, in temporary directories: a campaign runs to completion and its database
+//! holds every job with its metrics; the pivot returns the expected grid; adding sweep values runs only the new
+//! jobs; changing a parameter is refused without --force; a worker killed with `kill -9` at random moments is
+//! resumed to a result bit-identical to an uninterrupted run; `kill -9` of the dispatcher loses nothing.
+
+mod common;
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Stdio};
+use std::time::Duration;
+
+use common::granflow;
+use granflow::checkpoint::CheckpointSeries;
+use granflow::engine::state::first_difference;
+use rand::{RngExt, SeedableRng};
+
+/// A small drum campaign: 2 speeds × 2 fill levels, a fraction of a second each.
+fn campaign(speeds: &str, end_time_s: f64) -> String {
+    format!(
+        r#"
+name: mini
+seed: 7
+base:
+  domain: {{ lo_m: [-0.021, -0.021, 0.0], hi_m: [0.021, 0.021, 0.0064], periodic: [false, false, true] }}
+  gravity: {{ vector_m_per_s2: [0.0, -9.81, 0.0] }}
+  species:
+    - {{ name: red, radius_m: 0.0015, density_kg_per_m3: 2500.0, youngs_modulus_pa: 5.0e6, poisson_ratio: 0.3, friction_coefficient: 0.4 }}
+    - {{ name: blue, radius_m: 0.0015, density_kg_per_m3: 2500.0, youngs_modulus_pa: 5.0e6, poisson_ratio: 0.3, friction_coefficient: 0.4 }}
+  contact: {{ normal: {{ hertz: {{ restitution: 0.7 }} }}, tangential: mindlin }}
+  walls:
+    - drum: {{ name: drum, species: red, axis_point_m: [0.0, 0.0, 0.0], axis: [0.0, 0.0, 1.0], radius_m: 0.02, rotation_rpm: 30.0 }}
+  fill:
+    - lattice: {{ species: red, spacing_m: 0.0032, lo_m: [-0.02, -0.02, 0.0], hi_m: [0.0, 0.0, 0.0064], origin_m: [0.0016, 0.0016, 0.0016], inside_drum: drum }}
+    - lattice: {{ species: blue, spacing_m: 0.0032, lo_m: [0.0, -0.02, 0.0], hi_m: [0.02, 0.0, 0.0064], origin_m: [0.0016, 0.0016, 0.0016], inside_drum: drum }}
+  time: {{ dt_s: 2.0e-5, end_time_s: {end_time_s} }}
+  output: {{ series_every_steps: 500 }}
+sweep:
+  grid:
+    - {{ param: walls[0].drum.rotation_rpm, name: rotation_rpm, values: {speeds} }}
+    - zip:
+        - {{ param: fill[0].lattice.hi_m[1], name: fill_top_m, values: [-0.006, 0.0] }}
+        - {{ param: fill[1].lattice.hi_m[1], values: [-0.006, 0.0] }}
+metrics: [lacey_index, intensity_of_segregation, kinetic_energy_j, coordination_number]
+analysis: {{ mixing_species: red }}
+executor: {{ local: {{ max_parallel: 2 }} }}
+checkpoint: {{ every_steps: 1000, keep: 2 }}
+"#
+    )
+}
+
+fn write(dir: &Path, name: &str, text: &str) -> PathBuf {
+    let p = dir.join(name);
+    std::fs::write(&p, text).unwrap();
+    p
+}
+
+fn ok(args: &[&str], cwd: &Path) -> String {
+    let out = granflow(args, cwd);
+    assert!(
+        out.status.success(),
+        "granflow {args:?} exited {:?}: {}",
+        out.status.code(),
+        String::from_utf8_lossy(&out.stderr)
+    );
+    String::from_utf8_lossy(&out.stdout).into_owned()
+}
+
+fn sql(dir: &Path, query: &str) -> String {
+    ok(&["query", dir.to_str().unwrap(), "--sql", query, "--format", "csv"], dir)
+}
+
+#[test]
+fn a_campaign_runs_stores_every_job_and_pivots() {
+    let tmp = tempfile::tempdir().unwrap();
+    let file = write(tmp.path(), "mini.yaml", &campaign("[20.0, 60.0]", 0.06));
+    let out = tmp.path().join("out");
+    ok(&["run", file.to_str().unwrap(), "--out", out.to_str().unwrap(), "--quiet"], tmp.path());
+
+    let counts = sql(&out, "SELECT status, COUNT(*) FROM jobs GROUP BY status");
+    assert!(counts.contains("done,4"), "{counts}");
+    let metrics = sql(&out, "SELECT COUNT(*) FROM metrics WHERE value IS NOT NULL");
+    assert!(metrics.contains("16"), "4 jobs × 4 metrics: {metrics}");
+    for id in sql(&out, "SELECT job_id FROM jobs").lines().skip(1) {
+        let dir = out.join("jobs").join(id.trim());
+        assert!(dir.join("result.json").exists() && dir.join("series.h5").exists(), "{}", dir.display());
+    }
+
+    let pivot = ok(
+        &["query", out.to_str().unwrap(), "--pivot", "rotation_rpm", "fill_top_m", "--metric", "lacey_index", "--format", "csv"],
+        tmp.path(),
+    );
+    let lines: Vec<&str> = pivot.lines().collect();
+    assert_eq!(lines.len(), 3, "a header and one row per fill level:\n{pivot}");
+    assert!(lines[0].contains("20") && lines[0].contains("60"), "{pivot}");
+    for row in &lines[1..] {
+        let cells: Vec<&str> = row.split(',').collect();
+        assert_eq!(cells.len(), 3, "{pivot}");
+        for c in &cells[1..] {
+            let v: f64 = c.trim().parse().unwrap_or_else(|_| panic!("a number in every cell: {pivot}"));
+            assert!((-0.5..=1.01).contains(&v), "a Lacey index: {v}");
+        }
+    }
+
+    let export = ok(&["export", out.to_str().unwrap(), "--format", "csv"], tmp.path());
+    assert_eq!(export.lines().count(), 5, "{export}");
+    let status = ok(&["status", out.to_str().unwrap()], tmp.path());
+    assert!(status.contains("4 done"), "{status}");
+
+    // Adding a sweep value runs only the new jobs.
+    std::fs::write(&file, campaign("[20.0, 60.0, 90.0]", 0.06)).unwrap();
+    let before = sql(&out, "SELECT job_id, finished_at FROM jobs ORDER BY job_id");
+    ok(&["run", file.to_str().unwrap(), "--out", out.to_str().unwrap(), "--quiet"], tmp.path());
+    let after = sql(&out, "SELECT job_id, finished_at FROM jobs ORDER BY job_id");
+    for line in before.lines().skip(1) {
+        assert!(after.contains(line), "job {line} was not touched again");
+    }
+    assert!(sql(&out, "SELECT COUNT(*) FROM jobs WHERE status = 'done'").contains('6'));
+    let attempts = sql(&out, "SELECT MAX(attempt) FROM jobs");
+    assert!(attempts.lines().nth(1) == Some("1"), "every job ran once: {attempts}");
+
+    // Changing a parameter of existing jobs makes new jobs and is refused without --force.
+    std::fs::write(&file, campaign("[20.0, 60.0, 90.0]", 0.08)).unwrap();
+    let refused = granflow(&["run", file.to_str().unwrap(), "--out", out.to_str().unwrap(), "--quiet"], tmp.path());
+    assert_eq!(refused.status.code(), Some(2), "{}", String::from_utf8_lossy(&refused.stderr));
+    assert!(String::from_utf8_lossy(&refused.stderr).contains("--force"));
+}
+
+/// Runs `granflow worker <dir>` and kills it with SIGKILL after `delay`, unless it finishes first.
+fn worker_killed_after(dir: &Path, delay: Duration) -> bool {
+    let mut child = Command::new(env!("CARGO_BIN_EXE_granflow"))
+        .args(["worker", dir.to_str().unwrap()])
+        .stdout(Stdio::null())
+        .stderr(Stdio::null())
+        .spawn()
+        .unwrap();
+    std::thread::sleep(delay);
+    let finished = matches!(child.try_wait(), Ok(Some(_)));
+    let _ = child.kill();
+    let _ = child.wait();
+    finished
+}
+
+#[test]
+fn workers_killed_at_random_moments_resume_bit_identically() {
+    let tmp = tempfile::tempdir().unwrap();
+    let file = write(tmp.path(), "mini.yaml", &campaign("[60.0]", 0.1));
+    let reference = tmp.path().join("reference");
+    ok(&["run", file.to_str().unwrap(), "--out", reference.to_str().unwrap(), "--quiet"], tmp.path());
+    let id = sql(&reference, "SELECT job_id FROM jobs ORDER BY ordinal LIMIT 1").lines().nth(1).unwrap().trim().to_string();
+    let ref_dir = reference.join("jobs").join(&id);
+
+    let dir = tmp.path().join("killed");
+    std::fs::create_dir_all(&dir).unwrap();
+    std::fs::copy(ref_dir.join("job.json"), dir.join("job.json")).unwrap();
+    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(11);
+    let mut kills = 0;
+    for _ in 0..40 {
+        if dir.join("result.json").exists() {
+            break;
+        }
+        let delay = Duration::from_millis(rng.random_range(30..600));
+        if !worker_killed_after(&dir, delay) {
+            kills += 1;
+        }
+    }
+    while !dir.join("result.json").exists() {
+        worker_killed_after(&dir, Duration::from_secs(60));
+    }
+    assert!(kills >= 10, "only {kills} kills landed before the job finished; make it longer");
+
+    let read = |d: &Path| std::fs::read_to_string(d.join("result.json")).unwrap();
+    let metrics = |text: &str| -> serde_json::Value { serde_json::from_str::<serde_json::Value>(text).unwrap()["metrics"].clone() };
+    assert_eq!(metrics(&read(&dir)), metrics(&read(&ref_dir)), "metrics after {kills} kills");
+    let last = |d: &Path| CheckpointSeries::new(d, 2).latest_valid().unwrap().unwrap().state;
+    let (a, b) = (last(&dir), last(&ref_dir));
+    assert_eq!(first_difference(&a, &b), None, "final states after {kills} kills");
+    let series = |d: &Path| std::fs::read_to_string(d.join("series.csv")).unwrap();
+    assert_eq!(series(&dir), series(&ref_dir), "time series after {kills} kills");
+}
+
+#[test]
+fn killing_the_dispatcher_loses_nothing_and_resume_finishes() {
+    let tmp = tempfile::tempdir().unwrap();
+    let file = write(tmp.path(), "mini.yaml", &campaign("[20.0, 60.0]", 0.15));
+    let out = tmp.path().join("out");
+    let mut dispatcher = Command::new(env!("CARGO_BIN_EXE_granflow"))
+        .args(["run", file.to_str().unwrap(), "--out", out.to_str().unwrap(), "--quiet"])
+        .stdout(Stdio::null())
+        .stderr(Stdio::null())
+        .spawn()
+        .unwrap();
+    std::thread::sleep(Duration::from_millis(1500));
+    dispatcher.kill().unwrap();
+    dispatcher.wait().unwrap();
+    // Its workers notice (their stdin closes) and stop at once: nobody holds a job lock for long.
+    std::thread::sleep(Duration::from_millis(500));
+    ok(&["resume", out.to_str().unwrap(), "--quiet"], tmp.path());
+    assert!(sql(&out, "SELECT COUNT(*) FROM jobs WHERE status = 'done'").contains('4'));
+    assert!(sql(&out, "SELECT COUNT(*) FROM metrics").contains("16"), "no metric lost or duplicated");
+    assert!(sql(&out, "PRAGMA integrity_check").contains("ok"));
+    let finished = sql(&out, "SELECT COUNT(*) FROM attempts WHERE outcome = 'done'");
+    assert!(finished.lines().nth(1) == Some("4"), "no job finished twice: {finished}");
+}
