@@ -6,8 +6,8 @@ use std::path::{Path, PathBuf};
 use clap::{Parser, Subcommand};
 
 use crate::bench::{DemBenchOptions, bench_dem};
-use crate::error::Result;
 use crate::campaign::Campaign;
+use crate::error::Result;
 use crate::inspect::{self, Format};
 use crate::orchestrate::dispatcher::{DispatchOptions, run_campaign};
 use crate::simulate::{SimulateOptions, simulate};
@@ -95,6 +95,9 @@ pub enum Command {
         job_dir: PathBuf,
         #[arg(long, default_value_t = 1)]
         threads: usize,
+        /// Halve the scenario's time step this many times (a retry after a numerical failure).
+        #[arg(long, default_value_t = 0)]
+        dt_halvings: u32,
         /// Exit at once when stdin closes (the dispatcher is gone).
         #[arg(long)]
         watch_stdin: bool,
@@ -137,6 +140,13 @@ pub enum BenchCommand {
         #[arg(long, default_value = "liggghts")]
         liggghts_binary: PathBuf,
     },
+    /// The dispatcher's cost per job (a campaign of one-step jobs) and the time to resume it when all are done.
+    Campaign {
+        #[arg(long, default_value_t = 1000)]
+        jobs: usize,
+        #[arg(long, default_value_t = 2)]
+        max_parallel: usize,
+    },
 }
 
 /// Exit code of `run`/`resume` when some jobs failed for good.
@@ -162,7 +172,11 @@ fn dispatch_campaign(campaign: &Campaign, source: &Path, out: &Path, args: Dispa
         outcome.done,
         outcome.failed,
         outcome.pending,
-        if outcome.interrupted { " (interrupted: `granflow resume` finishes)" } else { "" }
+        if outcome.interrupted {
+            " (interrupted: `granflow resume` finishes)"
+        } else {
+            ""
+        }
     );
     Ok(if outcome.interrupted {
         EXIT_INTERRUPTED
@@ -215,6 +229,10 @@ pub fn run(cli: Cli) -> Result<i32> {
             liggghts_binary,
         })
         .map(|()| 0),
+        Command::Bench {
+            which: BenchCommand::Campaign { jobs, max_parallel },
+        } => crate::bench_campaign::bench_campaign(&crate::bench_campaign::CampaignBenchOptions { jobs, max_parallel })
+            .map(|()| 0),
         Command::Models => {
             print!("{}", crate::models_doc::MODELS);
             Ok(0)
@@ -246,7 +264,9 @@ pub fn run(cli: Cli) -> Result<i32> {
             format,
         } => {
             let text = match (pivot, sql) {
-                (Some(axes), None) => inspect::pivot(&dir, &axes[0], &axes[1], metric.as_deref().unwrap_or_default(), format)?,
+                (Some(axes), None) => {
+                    inspect::pivot(&dir, &axes[0], &axes[1], metric.as_deref().unwrap_or_default(), format)?
+                }
                 (None, Some(sql)) => inspect::sql(&dir, &sql, format)?,
                 _ => {
                     return Err(crate::Error::Usage(
@@ -264,11 +284,13 @@ pub fn run(cli: Cli) -> Result<i32> {
         Command::Worker {
             job_dir,
             threads,
+            dt_halvings,
             watch_stdin,
             max_steps,
         } => Ok(run_worker(&WorkerOptions {
             job_dir,
             threads,
+            dt_halvings,
             watch_stdin,
             max_steps,
         })),

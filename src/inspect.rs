@@ -40,7 +40,13 @@ fn open(dir: &Path) -> Result<(Store, i64, Campaign), Error> {
     let id = store
         .campaign_by_name(&campaign.spec.name)
         .map_err(store_err)?
-        .ok_or_else(|| Error::External(format!("{}: no campaign `{}` in the database", dir.display(), campaign.spec.name)))?
+        .ok_or_else(|| {
+            Error::External(format!(
+                "{}: no campaign `{}` in the database",
+                dir.display(),
+                campaign.spec.name
+            ))
+        })?
         .id;
     Ok((store, id, campaign))
 }
@@ -73,13 +79,19 @@ pub fn status(dir: &Path) -> Result<String, Error> {
     let live = dispatcher_running(dir);
     out += &format!(
         "dispatcher: {}\n",
-        if live { "running" } else { "not running (`granflow resume` finishes what is left)" }
+        if live {
+            "running"
+        } else {
+            "not running (`granflow resume` finishes what is left)"
+        }
     );
     let jobs_by_id: std::collections::HashMap<&str, &campaign::JobSpec> =
         campaign.jobs.iter().map(|j| (j.job_id.as_str(), j)).collect();
     let label = |id: &str| jobs_by_id.get(id).map(|j| j.label()).unwrap_or_default();
     for r in rows.iter().filter(|r| r.status == JobStatus::Running) {
-        let end = jobs_by_id.get(r.job_id.as_str()).map_or(f64::NAN, |j| j.scenario.time.end_time_s);
+        let end = jobs_by_id
+            .get(r.job_id.as_str())
+            .map_or(f64::NAN, |j| j.scenario.time.end_time_s);
         out += &format!(
             "  running {} ({}): t = {:.4} of {} s, attempt {}{}\n",
             r.job_id,
@@ -99,11 +111,16 @@ pub fn status(dir: &Path) -> Result<String, Error> {
             r.error.as_deref().unwrap_or("")
         );
     }
-    let walls: Vec<f64> = rows.iter().filter_map(|r| (r.status == JobStatus::Done).then_some(r.wall_time_s).flatten()).collect();
+    let walls: Vec<f64> = rows
+        .iter()
+        .filter_map(|r| (r.status == JobStatus::Done).then_some(r.wall_time_s).flatten())
+        .collect();
     if !walls.is_empty() && pending + running > 0 {
         let crate::campaign::spec::ExecutorSpec::Local(local) = &campaign.spec.executor;
         let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
-        let parallel = local.max_parallel.unwrap_or((cores / local.threads_per_job.max(1)).max(1));
+        let parallel = local
+            .max_parallel
+            .unwrap_or((cores / local.threads_per_job.max(1)).max(1));
         let mean = walls.iter().sum::<f64>() / walls.len() as f64;
         out += &format!(
             "ETA: about {:.0} s ({} jobs left × {:.1} s mean wall time / {} in parallel)\n",
@@ -118,7 +135,9 @@ pub fn status(dir: &Path) -> Result<String, Error> {
 
 /// Resolves a user's parameter name to a stored parameter path: the exact path, or the unique path ending in it.
 fn resolve_param(store: &Store, name: &str) -> Result<String, Error> {
-    let (_, rows) = store.query_sql("SELECT DISTINCT name FROM params ORDER BY name").map_err(store_err)?;
+    let (_, rows) = store
+        .query_sql("SELECT DISTINCT name FROM params ORDER BY name")
+        .map_err(store_err)?;
     let names: Vec<String> = rows.iter().filter_map(|r| r[0].as_str().map(str::to_string)).collect();
     if names.iter().any(|n| n == name) {
         return Ok(name.to_string());

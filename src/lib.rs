@@ -6,6 +6,7 @@
 
 pub mod analysis;
 pub mod bench;
+pub mod bench_campaign;
 pub mod campaign;
 pub mod checkpoint;
 pub mod cli;
@@ -13,10 +14,10 @@ pub mod engine;
 pub mod error;
 pub mod inspect;
 mod models_doc;
+pub mod orchestrate;
 pub mod scenario;
 pub mod simulate;
 pub mod store;
-pub mod orchestrate;
 pub mod worker;
 
 pub use error::{Error, Result};

@@ -129,6 +129,7 @@ pub fn simulate(opts: &SimulateOptions) -> Result<Summary> {
         &out,
         RunControl {
             threads: opts.threads,
+            dt_halvings: 0,
             max_steps: opts.max_steps,
             quiet: opts.quiet,
             stop: None,
@@ -177,6 +178,9 @@ impl RunObserver for NoObserver {}
 /// checkpoints at the next chunk boundary and returns with `finished = false`).
 pub struct RunControl<'a> {
     pub threads: usize,
+    /// When > 0, run with the scenario's time step halved this many times (from wherever the run resumes): how a
+    /// campaign retries a job that failed numerically.
+    pub dt_halvings: u32,
     pub max_steps: Option<u64>,
     pub quiet: bool,
     pub stop: Option<&'a AtomicBool>,
@@ -190,6 +194,7 @@ const CHUNK_STEPS: u64 = 500;
 pub fn run_in_dir(built: &BuiltScenario, out: &Path, ctl: RunControl) -> Result<(Summary, Simulation)> {
     let RunControl {
         threads,
+        dt_halvings,
         max_steps,
         quiet,
         stop,
@@ -255,7 +260,17 @@ pub fn run_in_dir(built: &BuiltScenario, out: &Path, ctl: RunControl) -> Result<
         }
     };
 
-    let total_steps = (built.spec.time.end_time_s / sim.dt_s).round() as u64;
+    if dt_halvings > 0 {
+        let dt_s = built.dt_s / f64::from(1u32 << dt_halvings.min(30));
+        if sim.dt_s != dt_s {
+            if !quiet {
+                eprintln!("time step {:.3e} s → {:.3e} s ({dt_halvings} halving(s))", sim.dt_s, dt_s);
+            }
+            sim.dt_s = dt_s;
+        }
+    }
+    // Steps to the end time from where the run is (the time step may have changed since the start).
+    let total_steps = sim.step + ((built.spec.time.end_time_s - sim.time_s) / sim.dt_s).round().max(0.0) as u64;
     let mut series_file = std::fs::OpenOptions::new()
         .append(true)
         .open(&series_path)

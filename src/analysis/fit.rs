@@ -62,8 +62,12 @@ const RATE_MAX_TIMES_SPACING: f64 = 30.0;
 /// If the slices differ in length.
 pub fn fit_exponential_decay(t_s: &[f64], y: &[f64]) -> Option<ExponentialFit> {
     assert_eq!(t_s.len(), y.len(), "fit_exponential_decay: one y per time");
-    let (t, y): (Vec<f64>, Vec<f64>) =
-        t_s.iter().zip(y).filter(|(t, y)| t.is_finite() && y.is_finite()).map(|(&t, &y)| (t, y)).unzip();
+    let (t, y): (Vec<f64>, Vec<f64>) = t_s
+        .iter()
+        .zip(y)
+        .filter(|(t, y)| t.is_finite() && y.is_finite())
+        .map(|(&t, &y)| (t, y))
+        .unzip();
     if t.len() < 4 {
         return None;
     }
@@ -80,7 +84,7 @@ pub fn fit_exponential_decay(t_s: &[f64], y: &[f64]) -> Option<ExponentialFit> {
 
     let mean_y = y.iter().sum::<f64>() / y.len() as f64;
     let sst = y.iter().map(|v| (v - mean_y) * (v - mean_y)).sum::<f64>();
-    if !(sst > 0.0) {
+    if sst.is_nan() || sst <= 0.0 {
         return None;
     }
 
@@ -98,7 +102,12 @@ pub fn fit_exponential_decay(t_s: &[f64], y: &[f64]) -> Option<ExponentialFit> {
     if best == 0 || best == RATE_GRID_POINTS - 1 {
         return None;
     }
-    let ln_k = brent_minimum(sse, ln_k_lo + step * (best - 1) as f64, ln_k_lo + step * (best + 1) as f64, 1e-12);
+    let ln_k = brent_minimum(
+        sse,
+        ln_k_lo + step * (best - 1) as f64,
+        ln_k_lo + step * (best + 1) as f64,
+        1e-12,
+    );
     let k_per_s = ln_k.exp();
     let (offset, amplitude, sse_min) = linear_part(&tau_s, &y, k_per_s);
     if !(amplitude != 0.0 && offset.is_finite() && amplitude.is_finite()) {
@@ -129,7 +138,11 @@ fn linear_part(tau_s: &[f64], y: &[f64], k_per_s: f64) -> (f64, f64, f64) {
     }
     let amplitude = if see > 1e-300 { sey / see } else { 0.0 };
     let offset = mean_y - amplitude * mean_e;
-    let sse = e.iter().zip(y).map(|(ei, yi)| (yi - offset - amplitude * ei).powi(2)).sum();
+    let sse = e
+        .iter()
+        .zip(y)
+        .map(|(ei, yi)| (yi - offset - amplitude * ei).powi(2))
+        .sum();
     (offset, amplitude, sse)
 }
 
@@ -222,7 +235,12 @@ pub fn time_to_fraction_of_max(t_s: &[f64], y: &[f64], fraction: f64) -> Option<
     if !fraction.is_finite() {
         return None;
     }
-    let finite = || t_s.iter().zip(y).filter(|(t, y)| t.is_finite() && y.is_finite()).map(|(&t, &y)| (t, y));
+    let finite = || {
+        t_s.iter()
+            .zip(y)
+            .filter(|(t, y)| t.is_finite() && y.is_finite())
+            .map(|(&t, &y)| (t, y))
+    };
     let max = finite().map(|(_, y)| y).max_by(f64::total_cmp)?;
     let level = fraction * max;
     let mut previous: Option<(f64, f64)> = None;
@@ -301,7 +319,10 @@ mod tests {
         // Too few points.
         assert_eq!(fit_exponential_decay(&t[..3], &[0.5, 0.3, 0.2]), None);
         // Only two distinct times.
-        assert_eq!(fit_exponential_decay(&[0.0, 0.0, 1.0, 1.0], &[0.5, 0.5, 0.3, 0.3]), None);
+        assert_eq!(
+            fit_exponential_decay(&[0.0, 0.0, 1.0, 1.0], &[0.5, 0.5, 0.3, 0.3]),
+            None
+        );
         // Constant.
         assert_eq!(fit_exponential_decay(&t, &vec![0.3; 30]), None);
         // A straight line: k → 0.
@@ -362,7 +383,10 @@ mod tests {
         let expected = 1.0 + (0.9 - 0.5) / (0.95 - 0.5);
         assert!((time_to_fraction_of_max(&t, &y, 0.9).expect("reached") - expected).abs() < 1e-12);
         // Already there at the first sample.
-        assert_eq!(time_to_fraction_of_max(&t, &[1.0, 0.2, 0.3, 0.4, 0.5, 0.6], 0.9), Some(0.0));
+        assert_eq!(
+            time_to_fraction_of_max(&t, &[1.0, 0.2, 0.3, 0.4, 0.5, 0.6], 0.9),
+            Some(0.0)
+        );
     }
 
     #[test]

@@ -94,7 +94,11 @@ pub fn granular_temperature(
         })
         .collect();
     GranularTemperature {
-        mean_m2_per_s2: if particles_counted > 0 { total_t / particles_counted as f64 } else { 0.0 },
+        mean_m2_per_s2: if particles_counted > 0 {
+            total_t / particles_counted as f64
+        } else {
+            0.0
+        },
         per_bin_m2_per_s2,
         mean_velocity_per_bin_m_per_s,
         particles_per_bin,
@@ -117,7 +121,7 @@ pub fn layer_bins(positions_m: &[Vec3], axis: usize, bottom_m: f64, top_m: f64, 
         .iter()
         .map(|p| {
             let h = p[axis];
-            if layers == 0 || !(thickness_m > 0.0) || !(h >= bottom_m && h <= top_m) {
+            if layers == 0 || thickness_m.is_nan() || thickness_m <= 0.0 || !(bottom_m..=top_m).contains(&h) {
                 return None;
             }
             Some((((h - bottom_m) / thickness_m).floor() as usize).min(layers - 1))
@@ -130,7 +134,11 @@ pub fn layer_bins(positions_m: &[Vec3], axis: usize, bottom_m: f64, top_m: f64, 
 /// Each particle–particle contact gives a neighbour to both of its particles. CHOICE: wall contacts are not counted
 /// (the seed says "contacting neighbors" of a particle and does not mention walls). 0 for an empty bed.
 pub fn mean_coordination_number(particle_count: usize, contact_pairs: usize) -> f64 {
-    if particle_count == 0 { 0.0 } else { 2.0 * contact_pairs as f64 / particle_count as f64 }
+    if particle_count == 0 {
+        0.0
+    } else {
+        2.0 * contact_pairs as f64 / particle_count as f64
+    }
 }
 
 /// N_c of every particle (seed 002: "the number of contacting neighbors of one particle") from its contact pairs.
@@ -154,7 +162,11 @@ pub fn coordination_numbers(particle_count: usize, contact_pairs: &[(u32, u32)])
 pub fn multicontact_ratio(coordination: &[u32]) -> f64 {
     let in_contact = coordination.iter().filter(|&&n| n >= 1).count();
     let multi = coordination.iter().filter(|&&n| n > 1).count();
-    if in_contact == 0 { 0.0 } else { multi as f64 / in_contact as f64 }
+    if in_contact == 0 {
+        0.0
+    } else {
+        multi as f64 / in_contact as f64
+    }
 }
 
 #[cfg(test)]
@@ -168,14 +180,16 @@ mod tests {
     fn rigid_motion_has_no_temperature_and_a_known_fluctuation_does() {
         let drift = Vec3::new(0.3, -0.1, 0.05);
         let v = vec![drift; 10];
-        let t = granular_temperature(&v, &vec![Some(0); 10], 1);
+        let t = granular_temperature(&v, &[Some(0); 10], 1);
         // Zero up to the rounding of the mean (sum/10 is not exactly the drift).
         assert!(t.mean_m2_per_s2 < 1e-32, "{}", t.mean_m2_per_s2);
         assert_eq!(t.particles_counted, 10);
         // ±a along x about the drift: every particle has (a²)/3.
         let a = 0.2;
-        let v: Vec<Vec3> = (0..10).map(|i| drift + Vec3::new(if i % 2 == 0 { a } else { -a }, 0.0, 0.0)).collect();
-        let t = granular_temperature(&v, &vec![Some(0); 10], 1);
+        let v: Vec<Vec3> = (0..10)
+            .map(|i| drift + Vec3::new(if i % 2 == 0 { a } else { -a }, 0.0, 0.0))
+            .collect();
+        let t = granular_temperature(&v, &[Some(0); 10], 1);
         assert!((t.mean_m2_per_s2 - a * a / 3.0).abs() < 1e-15);
         assert!((t.mean_velocity_per_bin_m_per_s[0] - drift).norm() < 1e-15);
     }
@@ -184,8 +198,13 @@ mod tests {
     fn layers_remove_a_mean_shear_that_one_bin_would_count() {
         // Simple shear u_x = γ̇ y with no fluctuation: zero per layer, but one bin sees the profile as spread.
         let shear_rate_per_s = 50.0;
-        let positions: Vec<Vec3> = (0..400).map(|i| Vec3::new((i % 20) as f64 * 1e-3, (i / 20) as f64 * 1e-3, 0.0)).collect();
-        let v: Vec<Vec3> = positions.iter().map(|p| Vec3::new(shear_rate_per_s * p.y, 0.0, 0.0)).collect();
+        let positions: Vec<Vec3> = (0..400)
+            .map(|i| Vec3::new((i % 20) as f64 * 1e-3, (i / 20) as f64 * 1e-3, 0.0))
+            .collect();
+        let v: Vec<Vec3> = positions
+            .iter()
+            .map(|p| Vec3::new(shear_rate_per_s * p.y, 0.0, 0.0))
+            .collect();
         let bins = layer_bins(&positions, 1, -0.5e-3, 19.5e-3, 20);
         assert!(bins.iter().all(|b| b.is_some()));
         let layered = granular_temperature(&v, &bins, 20);
@@ -195,7 +214,11 @@ mod tests {
         let whole = granular_temperature(&v, &vec![Some(0); 400], 1);
         let level = shear_rate_per_s * 1e-3;
         let expected = level * level * (400.0 - 1.0) / 12.0 / 3.0;
-        assert!((whole.mean_m2_per_s2 - expected).abs() < 1e-12 * expected.max(1.0), "{} {expected}", whole.mean_m2_per_s2);
+        assert!(
+            (whole.mean_m2_per_s2 - expected).abs() < 1e-12 * expected.max(1.0),
+            "{} {expected}",
+            whole.mean_m2_per_s2
+        );
     }
 
     #[test]
@@ -209,7 +232,9 @@ mod tests {
             s * (-2.0 * u1.ln()).sqrt() * (std::f64::consts::TAU * u2).cos()
         };
         let n = 60_000;
-        let v: Vec<Vec3> = (0..n).map(|_| Vec3::new(1.0 + normal(), normal(), -2.0 + normal())).collect();
+        let v: Vec<Vec3> = (0..n)
+            .map(|_| Vec3::new(1.0 + normal(), normal(), -2.0 + normal()))
+            .collect();
         let bins: Vec<Option<usize>> = (0..n).map(|i| Some(i % 6)).collect();
         let t = granular_temperature(&v, &bins, 6);
         assert!((t.mean_m2_per_s2 / (s * s) - 1.0).abs() < 0.02, "{}", t.mean_m2_per_s2);
@@ -220,7 +245,12 @@ mod tests {
 
     #[test]
     fn singletons_and_excluded_particles_do_not_count() {
-        let v = vec![Vec3::new(1.0, 0.0, 0.0), Vec3::new(-1.0, 0.0, 0.0), Vec3::new(5.0, 5.0, 5.0), Vec3::new(9.0, 0.0, 0.0)];
+        let v = vec![
+            Vec3::new(1.0, 0.0, 0.0),
+            Vec3::new(-1.0, 0.0, 0.0),
+            Vec3::new(5.0, 5.0, 5.0),
+            Vec3::new(9.0, 0.0, 0.0),
+        ];
         let bins = [Some(0), Some(0), Some(1), None];
         let t = granular_temperature(&v, &bins, 3);
         assert_eq!(t.particles_counted, 2);
@@ -236,7 +266,10 @@ mod tests {
     fn layer_bins_edges() {
         let p = |y: f64| Vec3::new(0.0, y, 0.0);
         let positions = [p(0.0), p(0.999), p(1.0), p(3.0), p(-0.1), p(3.1), p(f64::NAN)];
-        assert_eq!(layer_bins(&positions, 1, 0.0, 3.0, 3), vec![Some(0), Some(0), Some(1), Some(2), None, None, None]);
+        assert_eq!(
+            layer_bins(&positions, 1, 0.0, 3.0, 3),
+            vec![Some(0), Some(0), Some(1), Some(2), None, None, None]
+        );
         assert!(layer_bins(&positions, 1, 0.0, 3.0, 0).iter().all(|b| b.is_none()));
         assert!(layer_bins(&positions, 1, 3.0, 3.0, 2).iter().all(|b| b.is_none()));
     }

@@ -59,9 +59,10 @@ pub struct MixingState {
 ///   its formula value N/(N − 1) (the bed is as even as it can be measured);
 /// - one species only, no particles, or no volume (σ0² = 0): nothing can segregate, so IS = 0, RSD = 0 and M = 1;
 /// - a sample with no volume (all its particles have zero volume) takes c_i = P;
-/// - c̄ = 0 (no A anywhere) gives RSD = 0.
+/// - c̄ = 0 (possible only when every A particle has zero volume) gives RSD = 0.
 ///
-/// Cost: O(n·k) on a uniform grid; about 35 ms for 100,000 particles and k = 10 (see the `timing_100k` test).
+/// Cost: O(n·k) on a uniform grid, serial; about 75 ms for 100,000 random particles and k = 10 (`cargo test --release
+/// --lib analysis::mixing::tests::timing_100k -- --ignored --nocapture`).
 ///
 /// # Panics
 /// If the three slices differ in length.
@@ -82,7 +83,7 @@ pub fn mixing_state(positions_m: &[Vec3], volumes_m3: &[f64], is_a: &[bool], nei
     }
     let fraction_a = if volume_m3 > 0.0 { volume_a_m3 / volume_m3 } else { 0.0 };
     let sigma0_sq = fraction_a * (1.0 - fraction_a);
-    if n == 0 || !(sigma0_sq > 0.0) {
+    if n == 0 || sigma0_sq.is_nan() || sigma0_sq <= 0.0 {
         return MixingState {
             fraction_a,
             intensity_of_segregation: 0.0,
@@ -108,7 +109,11 @@ pub fn mixing_state(positions_m: &[Vec3], volumes_m3: &[f64], is_a: &[bool], nei
         .collect();
 
     let mean = local.iter().sum::<f64>() / n as f64;
-    let variance = if n > 1 { local.iter().map(|c| (c - mean) * (c - mean)).sum::<f64>() / (n - 1) as f64 } else { 0.0 };
+    let variance = if n > 1 {
+        local.iter().map(|c| (c - mean) * (c - mean)).sum::<f64>() / (n - 1) as f64
+    } else {
+        0.0
+    };
     let sigma = variance.sqrt();
     MixingState {
         fraction_a,
@@ -181,7 +186,11 @@ pub fn above_median_height(heights_m: &[f64]) -> Vec<bool> {
     }
     sorted.sort_by(f64::total_cmp);
     let m = sorted.len();
-    let median_m = if m % 2 == 1 { sorted[m / 2] } else { 0.5 * (sorted[m / 2 - 1] + sorted[m / 2]) };
+    let median_m = if m % 2 == 1 {
+        sorted[m / 2]
+    } else {
+        0.5 * (sorted[m / 2 - 1] + sorted[m / 2])
+    };
     heights_m.iter().map(|&h| h >= median_m).collect()
 }
 
@@ -225,7 +234,10 @@ mod tests {
             assert!((s.fraction_a - p).abs() < 1e-12);
             let expected_is = (p * (1.0 - p) * nf / (nf - 1.0)).sqrt();
             assert!((s.intensity_of_segregation - expected_is).abs() < 1e-12, "{s:?}");
-            assert!((s.lacey_index - (-nf / ((nf - 1.0) * (nf - 1.0)))).abs() < 1e-12, "{s:?}");
+            assert!(
+                (s.lacey_index - (-nf / ((nf - 1.0) * (nf - 1.0)))).abs() < 1e-12,
+                "{s:?}"
+            );
             assert!((s.relative_standard_deviation - expected_is / p).abs() < 1e-12, "{s:?}");
             assert_eq!(s.samples, n);
         }
@@ -253,7 +265,10 @@ mod tests {
         let mean_shift = 2.0 * (column - interior) * (2.0 / 7.0) / n as f64;
         let lo = ((sum_lo - n as f64 * mean_shift * mean_shift) / (n - 1) as f64).sqrt();
         let hi = (sum_hi / (n - 1) as f64).sqrt();
-        assert!(lo <= s.intensity_of_segregation && s.intensity_of_segregation <= hi, "{lo} ≤ {s:?} ≤ {hi}");
+        assert!(
+            lo <= s.intensity_of_segregation && s.intensity_of_segregation <= hi,
+            "{lo} ≤ {s:?} ≤ {hi}"
+        );
         assert!(hi < 0.49, "the band excludes the ideal 0.5");
         assert!(s.lacey_index > 0.0 && s.lacey_index < 0.07, "{s:?}");
     }
@@ -261,7 +276,13 @@ mod tests {
     fn random_mixture(n: usize, p: f64, seed: u64) -> (Vec<Vec3>, Vec<bool>) {
         let mut rng = ChaCha8Rng::seed_from_u64(seed);
         let positions = (0..n)
-            .map(|_| Vec3::new(rng.random::<f64>() * 0.04, rng.random::<f64>() * 0.03, rng.random::<f64>() * 0.02))
+            .map(|_| {
+                Vec3::new(
+                    rng.random::<f64>() * 0.04,
+                    rng.random::<f64>() * 0.03,
+                    rng.random::<f64>() * 0.02,
+                )
+            })
             .collect();
         let is_a = (0..n).map(|_| rng.random::<f64>() < p).collect();
         (positions, is_a)
@@ -278,7 +299,11 @@ mod tests {
             assert!((p_real - p).abs() < 0.01);
             let expected_is = (p_real * (1.0 - p_real) / (k + 1) as f64).sqrt();
             let rel = (s.intensity_of_segregation / expected_is - 1.0).abs();
-            assert!(rel < 0.03, "IS {} vs {expected_is} (p {p}, k {k})", s.intensity_of_segregation);
+            assert!(
+                rel < 0.03,
+                "IS {} vs {expected_is} (p {p}, k {k})",
+                s.intensity_of_segregation
+            );
             let expected_m = 1.0 - 1.0 / (k + 1) as f64;
             assert!((s.lacey_index - expected_m).abs() < 0.02, "{s:?}");
             assert!(s.lacey_index > 0.78, "a random mixture is near the mixed end");
@@ -315,9 +340,12 @@ mod tests {
         let (positions, _) = random_mixture(50, 0.5, 3);
         let volumes = vec![1e-9; 50];
         for all_a in [true, false] {
-            let s = mixing_state(&positions, &volumes, &vec![all_a; 50], 10);
+            let s = mixing_state(&positions, &volumes, &[all_a; 50], 10);
             assert_eq!(s.fraction_a, if all_a { 1.0 } else { 0.0 });
-            assert_eq!((s.intensity_of_segregation, s.lacey_index, s.relative_standard_deviation), (0.0, 1.0, 0.0));
+            assert_eq!(
+                (s.intensity_of_segregation, s.lacey_index, s.relative_standard_deviation),
+                (0.0, 1.0, 0.0)
+            );
         }
         // Both species present but no volume at all.
         let alternate: Vec<bool> = (0..50).map(|i| i % 2 == 0).collect();
@@ -367,7 +395,10 @@ mod tests {
         assert_eq!(height_mixing_index(&[0.0, 0.0], &[true, false]), 1.0);
         // Median of an odd count and ties at the median: those at the median are in family 1.
         assert_eq!(above_median_height(&[3.0, 1.0, 2.0]), vec![true, false, true]);
-        assert_eq!(above_median_height(&[1.0, 2.0, 2.0, 2.0]), vec![false, true, true, true]);
+        assert_eq!(
+            above_median_height(&[1.0, 2.0, 2.0, 2.0]),
+            vec![false, true, true, true]
+        );
         assert_eq!(above_median_height(&[f64::NAN, 1.0, 2.0]), vec![false, false, true]);
         assert!(above_median_height(&[]).is_empty());
     }
@@ -391,7 +422,10 @@ mod tests {
             last = Some(s);
         }
         times.sort();
-        println!("mixing_state: {n} particles, k = 10: median {:?} (min {:?}, max {:?})", times[2], times[0], times[4]);
+        println!(
+            "mixing_state: {n} particles, k = 10: median {:?} (min {:?}, max {:?})",
+            times[2], times[0], times[4]
+        );
         assert!(times[2] < std::time::Duration::from_millis(500), "well under a second");
     }
 }

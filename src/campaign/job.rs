@@ -61,6 +61,5 @@ impl JobSpec {
 
 /// The last key of a parameter path (`walls[0].drum.rotation_rpm` → `rotation_rpm`), the name shown in tables.
 pub fn short_name(path: &str) -> &str {
-    let last = path.rsplit('.').next().unwrap_or(path);
-    last
+    path.rsplit('.').next().unwrap_or(path)
 }

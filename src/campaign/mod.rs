@@ -38,7 +38,11 @@ impl Campaign {
             .iter()
             .filter_map(|(k, v)| self.axis_names.get(k).map(|n| format!("{n}={v}")))
             .collect();
-        if named.is_empty() { job.label() } else { named.join(", ") }
+        if named.is_empty() {
+            job.label()
+        } else {
+            named.join(", ")
+        }
     }
 
     /// The name a parameter is stored and queried under.
@@ -67,10 +71,15 @@ pub fn load(path: &Path) -> Result<Campaign, ConfigError> {
 /// As [`load`], from text (`path` is used in messages).
 pub fn from_yaml(yaml: &str, path: &Path) -> Result<Campaign, ConfigError> {
     let spec: CampaignSpec = scenario::parse_yaml(yaml, path)?;
+    check_finite(yaml).map_err(|(key, m)| invalid(path, key, m))?;
     check_name(&spec.name).map_err(|m| invalid(path, "name", m))?;
     metrics::check(&spec).map_err(|(key, m)| invalid(path, key, m))?;
     if spec.checkpoint.every_steps == 0 {
-        return Err(invalid(path, "checkpoint.every_steps", "expected a number of steps > 0"));
+        return Err(invalid(
+            path,
+            "checkpoint.every_steps",
+            "expected a number of steps > 0",
+        ));
     }
     if spec.checkpoint.keep == 0 {
         return Err(invalid(path, "checkpoint.keep", "expected at least 1 checkpoint kept"));
@@ -85,7 +94,11 @@ pub fn from_yaml(yaml: &str, path: &Path) -> Result<Campaign, ConfigError> {
     if let Some(t) = local.job_timeout_s
         && !(t.is_finite() && t > 0.0)
     {
-        return Err(invalid(path, "executor.local.job_timeout_s", format!("expected a time > 0, got {t}")));
+        return Err(invalid(
+            path,
+            "executor.local.job_timeout_s",
+            format!("expected a time > 0, got {t}"),
+        ));
     }
     if !(local.heartbeat_timeout_s.is_finite() && local.heartbeat_timeout_s > 0.0) {
         return Err(invalid(
@@ -99,7 +112,11 @@ pub fn from_yaml(yaml: &str, path: &Path) -> Result<Campaign, ConfigError> {
     let names = sweep::axis_names(&spec.sweep);
     for (k, (p, n)) in names.iter().enumerate() {
         if names[..k].iter().any(|(p2, n2)| n2 == n && p2 != p) {
-            return Err(invalid(path, "sweep", format!("axis name `{n}` is given to two parameters")));
+            return Err(invalid(
+                path,
+                "sweep",
+                format!("axis name `{n}` is given to two parameters"),
+            ));
         }
     }
     if points.len() > spec.max_jobs {
@@ -114,17 +131,21 @@ pub fn from_yaml(yaml: &str, path: &Path) -> Result<Campaign, ConfigError> {
         ));
     }
     let base = base_document(&spec);
+    let mut param_keys: HashMap<String, String> = HashMap::new();
+    for (param, key) in sweep::param_keys(&spec.sweep, "sweep") {
+        param_keys.entry(param).or_insert(key);
+    }
     let mut jobs = Vec::with_capacity(points.len());
     let mut seen: HashMap<String, usize> = HashMap::new();
     for (ordinal, point) in points.into_iter().enumerate() {
-        let job = resolve(&spec, &base, point, ordinal, path)?;
+        let job = resolve(&spec, &base, point, ordinal, &param_keys, path)?;
         if let Some(&first) = seen.get(&job.job_id) {
             return Err(invalid(
                 path,
                 "sweep",
                 format!(
-                    "points {first} and {ordinal} give the same job ({}); remove the duplicate",
-                    job.label()
+                    "sweep points {first} and {ordinal} give the same job ({}); remove the duplicate",
+                    describe(&job.params)
                 ),
             ));
         }
@@ -137,6 +158,44 @@ pub fn from_yaml(yaml: &str, path: &Path) -> Result<Campaign, ConfigError> {
         jobs,
         axis_names: names.into_iter().collect(),
     })
+}
+
+/// Rejects non-finite numbers (`.nan`, `.inf`) in `base` and `sweep`: jobs are resolved through JSON, which has
+/// no such values and would silently turn them into `null` (read back as a missing optional value, or as a type
+/// error naming the wrong thing). Errors are (key path, message).
+fn check_finite(yaml: &str) -> Result<(), (String, String)> {
+    fn walk(v: &serde_norway::Value, key: &str) -> Result<(), (String, String)> {
+        use serde_norway::Value;
+        match v {
+            Value::Number(n) => match n.as_f64() {
+                Some(x) if !x.is_finite() => Err((key.to_string(), format!("expected a finite number, got {x}"))),
+                _ => Ok(()),
+            },
+            Value::Sequence(items) => items
+                .iter()
+                .enumerate()
+                .try_for_each(|(i, item)| walk(item, &format!("{key}[{i}]"))),
+            Value::Mapping(map) => map.iter().try_for_each(|(k, item)| {
+                let name = match k {
+                    Value::String(s) => s.clone(),
+                    other => serde_norway::to_string(other).unwrap_or_default().trim().to_string(),
+                };
+                walk(item, &format!("{key}.{name}"))
+            }),
+            Value::Tagged(tagged) => walk(&tagged.value, key),
+            Value::Null | Value::Bool(_) | Value::String(_) => Ok(()),
+        }
+    }
+    // The text has parsed as a campaign already, so it parses as a YAML value.
+    let Ok(doc) = serde_norway::from_str::<serde_norway::Value>(yaml) else {
+        return Ok(());
+    };
+    for section in ["base", "sweep"] {
+        if let Some(v) = doc.get(section) {
+            walk(v, section)?;
+        }
+    }
+    Ok(())
 }
 
 fn check_name(name: &str) -> Result<(), String> {
@@ -159,26 +218,37 @@ fn base_document(spec: &CampaignSpec) -> serde_json::Value {
     serde_json::to_value(&base).expect("a scenario serialises")
 }
 
-/// Applies one sweep point to the base and derives the job's seed and id.
+/// Applies one sweep point to the base and derives the job's seed and id. `param_keys` gives the key in the campaign
+/// file where each parameter path is set (for messages).
 fn resolve(
     spec: &CampaignSpec,
     base: &serde_json::Value,
-    point: sweep::Point,
+    mut point: sweep::Point,
     ordinal: usize,
+    param_keys: &HashMap<String, String>,
     path: &Path,
 ) -> Result<JobSpec, ConfigError> {
     let mut doc = base.clone();
     let mut seen_paths: Vec<&str> = Vec::new();
     for (param, value) in &point {
+        let key = param_keys.get(param).map_or("sweep", String::as_str);
         if seen_paths.contains(&param.as_str()) {
-            return Err(invalid(path, "sweep", format!("parameter `{param}` is set twice in one point")));
+            return Err(invalid(
+                path,
+                key,
+                format!("parameter `{param}` is set twice in one point"),
+            ));
         }
         seen_paths.push(param);
         if param == "name" {
-            return Err(invalid(path, "sweep", "the scenario name is the campaign's; it cannot be swept"));
+            return Err(invalid(
+                path,
+                key,
+                "the scenario name is the campaign's (`name` at the top level); it cannot be swept",
+            ));
         }
         sweep::set_path(&mut doc, param, value.clone())
-            .map_err(|m| invalid(path, "sweep", format!("parameter `{param}`: {m}")))?;
+            .map_err(|m| invalid(path, key, format!("parameter `{param}`: {m}")))?;
     }
     let mut scenario: ScenarioSpec = serde_path_to_error::deserialize(&doc).map_err(|e| {
         let key = e.path().to_string();
@@ -188,6 +258,14 @@ fn resolve(
             format!("{} (at sweep point {ordinal}: {})", e.inner(), describe(&point)),
         )
     })?;
+    // Each value as the scenario reads it (`20` for a number of rpm is `20.0`), so that two spellings of one value
+    // make one job (same seed, same id: reported as a duplicate) rather than two.
+    let resolved = serde_json::to_value(&scenario).expect("a scenario serialises");
+    for (param, value) in &mut point {
+        if let Some(v) = sweep::get_path(&resolved, param) {
+            *value = v.clone();
+        }
+    }
     if !point.iter().any(|(p, _)| p == "seed") {
         let params = serde_json::to_string(&point).expect("params serialise");
         let mut bytes = spec.seed.to_le_bytes().to_vec();
@@ -223,9 +301,11 @@ pub fn validate_jobs<'a>(jobs: impl IntoIterator<Item = &'a JobSpec>, path: &Pat
         if let Err(e) = scenario::build(job.scenario.clone(), path) {
             let point = describe(&job.params);
             return Err(match e {
-                ConfigError::Invalid { key, message, .. } => {
-                    invalid(path, format!("base.{key}"), format!("{message} (at sweep point {point})"))
-                }
+                ConfigError::Invalid { key, message, .. } => invalid(
+                    path,
+                    format!("base.{key}"),
+                    format!("{message} (at sweep point {point})"),
+                ),
                 other => other,
             });
         }

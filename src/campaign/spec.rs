@@ -206,6 +206,13 @@ pub struct RetryPolicy {
     /// The worker stopped sending heartbeats.
     #[serde(default = "two")]
     pub lost: u32,
+    /// A numerical retry resumes from the last checkpoint with the time step halved (once more per retry).
+    #[serde(default = "yes")]
+    pub halve_dt_on_numerical: bool,
+}
+
+fn yes() -> bool {
+    true
 }
 
 fn two() -> u32 {
@@ -223,6 +230,7 @@ impl Default for RetryPolicy {
             killed: 3,
             timeout: 0,
             lost: 2,
+            halve_dt_on_numerical: true,
         }
     }
 }

@@ -38,12 +38,18 @@ pub fn expand(node: &SweepNode, key: &str) -> Result<Vec<Point>, SweepError> {
     .map(|(name, _)| *name)
     .collect();
     if node.name.is_some() && node.param.is_none() {
-        return Err(fail(&format!("{key}.name"), "`name` names a `param` axis; this node has no `param`"));
+        return Err(fail(
+            &format!("{key}.name"),
+            "`name` names a `param` axis; this node has no `param`",
+        ));
     }
     if let Some(name) = &node.name
         && (name.is_empty() || !name.chars().all(|c| c.is_ascii_alphanumeric() || c == '_'))
     {
-        return Err(fail(&format!("{key}.name"), format!("expected letters, digits and `_`, got `{name}`")));
+        return Err(fail(
+            &format!("{key}.name"),
+            format!("expected letters, digits and `_`, got `{name}`"),
+        ));
     }
     match kinds.as_slice() {
         ["param"] => axis(node, key),
@@ -78,6 +84,31 @@ pub fn axis_names(node: &SweepNode) -> Vec<(String, String)> {
     out
 }
 
+/// Where each parameter path is set in the campaign file, as (canonical path, key of its `param` or of the `list`
+/// point that sets it); the first place wins. Used to name the key when a path does not fit the base scenario.
+pub fn param_keys(node: &SweepNode, key: &str) -> Vec<(String, String)> {
+    let mut out = Vec::new();
+    if let Some(p) = &node.param
+        && let Ok(p) = canonical_path(p)
+    {
+        out.push((p, format!("{key}.param")));
+    }
+    for (c, child) in node.grid.iter().flatten().enumerate() {
+        out.extend(param_keys(child, &format!("{key}.grid[{c}]")));
+    }
+    for (c, child) in node.zip.iter().flatten().enumerate() {
+        out.extend(param_keys(child, &format!("{key}.zip[{c}]")));
+    }
+    for (k, point) in node.list.iter().flatten().enumerate() {
+        for path in point.keys() {
+            if let Ok(p) = canonical_path(path) {
+                out.push((p, format!("{key}.list[{k}]")));
+            }
+        }
+    }
+    out
+}
+
 fn axis(node: &SweepNode, key: &str) -> Result<Vec<Point>, SweepError> {
     let param = node.param.as_deref().unwrap_or_default();
     let param_key = format!("{key}.param");
@@ -96,13 +127,28 @@ fn axis(node: &SweepNode, key: &str) -> Result<Vec<Point>, SweepError> {
             key,
             format!(
                 "parameter `{param}`: expected exactly one of `values`, `linspace`, `logspace`, found {}",
-                if given.is_empty() { "none".to_string() } else { given.join(", ") }
+                if given.is_empty() {
+                    "none".to_string()
+                } else {
+                    given.join(", ")
+                }
             ),
         ));
     }
     let values: Vec<Value> = if let Some(values) = &node.values {
         if values.is_empty() {
-            return Err(fail(&format!("{key}.values"), "expected at least one value, got an empty list"));
+            return Err(fail(
+                &format!("{key}.values"),
+                "expected at least one value, got an empty list",
+            ));
+        }
+        for (k, v) in values.iter().enumerate() {
+            if let Some(first) = values[..k].iter().position(|w| w == v) {
+                return Err(fail(
+                    &format!("{key}.values[{k}]"),
+                    format!("expected distinct values, got {v} twice (also at values[{first}]); remove the duplicate"),
+                ));
+            }
         }
         values.clone()
     } else if let Some(r) = &node.linspace {
@@ -117,7 +163,10 @@ fn axis(node: &SweepNode, key: &str) -> Result<Vec<Point>, SweepError> {
 
 fn spaced(r: &Range, key: &str, geometric: bool) -> Result<Vec<Value>, SweepError> {
     if !(r.start.is_finite() && r.stop.is_finite()) {
-        return Err(fail(key, format!("expected finite start and stop, got {} and {}", r.start, r.stop)));
+        return Err(fail(
+            key,
+            format!("expected finite start and stop, got {} and {}", r.start, r.stop),
+        ));
     }
     if r.num == 0 {
         return Err(fail(&format!("{key}.num"), "expected at least one point, got 0"));
@@ -125,7 +174,10 @@ fn spaced(r: &Range, key: &str, geometric: bool) -> Result<Vec<Value>, SweepErro
     if geometric && !(r.start > 0.0 && r.stop > 0.0) {
         return Err(fail(
             key,
-            format!("expected start and stop > 0 for a geometric range, got {} and {}", r.start, r.stop),
+            format!(
+                "expected start and stop > 0 for a geometric range, got {} and {}",
+                r.start, r.stop
+            ),
         ));
     }
     let n = r.num;
@@ -185,7 +237,10 @@ fn zip(children: &[SweepNode], key: &str) -> Result<Vec<Point>, SweepError> {
     if let Some((c, other)) = expanded.iter().enumerate().find(|(_, e)| e.len() != len) {
         return Err(fail(
             &format!("{key}[{c}]"),
-            format!("zip expects sweeps of equal length: {key}[0] has {len} points, this one {}", other.len()),
+            format!(
+                "zip expects sweeps of equal length: {key}[0] has {len} points, this one {}",
+                other.len()
+            ),
         ));
     }
     Ok((0..len)
@@ -202,7 +257,10 @@ fn list(points: &[serde_json::Map<String, Value>], key: &str) -> Result<Vec<Poin
         .enumerate()
         .map(|(k, map)| {
             if map.is_empty() {
-                return Err(fail(&format!("{key}[{k}]"), "expected a map of parameter paths to values, got {}"));
+                return Err(fail(
+                    &format!("{key}[{k}]"),
+                    "expected a map of parameter paths to values, got {}",
+                ));
             }
             map.iter()
                 .map(|(path, v)| {
@@ -299,10 +357,16 @@ pub fn set_path(doc: &mut Value, path: &str, value: Value) -> Result<(), String>
                 };
                 if !map.contains_key(&k) {
                     let known: Vec<&str> = map.keys().map(|s| s.as_str()).collect();
-                    let hint = did_you_mean(&k, &known).map(|s| format!("; did you mean `{s}`?")).unwrap_or_default();
+                    let hint = did_you_mean(&k, &known)
+                        .map(|s| format!("; did you mean `{s}`?"))
+                        .unwrap_or_default();
                     return Err(format!(
-                        "the scenario has no `{k}` at `{}` (there: {}){hint}",
-                        if walked.is_empty() { "top level" } else { &walked },
+                        "the scenario has no `{k}` {} (there: {}){hint}",
+                        if walked.is_empty() {
+                            "at the top level".to_string()
+                        } else {
+                            format!("at `{walked}`")
+                        },
                         known.join(", ")
                     ));
                 }
@@ -327,6 +391,14 @@ pub fn set_path(doc: &mut Value, path: &str, value: Value) -> Result<(), String>
     }
     *here = value;
     Ok(())
+}
+
+/// The value at `path` in `doc`, if there is one.
+pub fn get_path<'a>(doc: &'a Value, path: &str) -> Option<&'a Value> {
+    parse_path(path).ok()?.into_iter().try_fold(doc, |here, seg| match seg {
+        Segment::Key(k) => here.get(k.as_str()),
+        Segment::Index(i) => here.get(i),
+    })
 }
 
 fn kind(v: &Value) -> &'static str {
@@ -401,9 +473,15 @@ mod tests {
             ]),
             ..Default::default()
         };
-        assert_eq!(expand(&ok, "sweep").unwrap()[1], vec![("a".into(), json!(2)), ("b".into(), json!(4))]);
+        assert_eq!(
+            expand(&ok, "sweep").unwrap()[1],
+            vec![("a".into(), json!(2)), ("b".into(), json!(4))]
+        );
         let bad = SweepNode {
-            zip: Some(vec![axis_node("a", vec![json!(1), json!(2)]), axis_node("b", vec![json!(3)])]),
+            zip: Some(vec![
+                axis_node("a", vec![json!(1), json!(2)]),
+                axis_node("b", vec![json!(3)]),
+            ]),
             ..Default::default()
         };
         let e = expand(&bad, "sweep").unwrap_err();
@@ -412,20 +490,68 @@ mod tests {
 
     #[test]
     fn linspace_and_logspace_hit_their_ends_exactly() {
-        let lin = spaced(&Range { start: 1.0, stop: 2.0, num: 3 }, "k", false).unwrap();
+        let lin = spaced(
+            &Range {
+                start: 1.0,
+                stop: 2.0,
+                num: 3,
+            },
+            "k",
+            false,
+        )
+        .unwrap();
         assert_eq!(lin, vec![json!(1.0), json!(1.5), json!(2.0)]);
-        let log = spaced(&Range { start: 0.01, stop: 1.0, num: 3 }, "k", true).unwrap();
+        let log = spaced(
+            &Range {
+                start: 0.01,
+                stop: 1.0,
+                num: 3,
+            },
+            "k",
+            true,
+        )
+        .unwrap();
         assert_eq!(log[0], json!(0.01));
         assert!((log[1].as_f64().unwrap() - 0.1).abs() < 1e-15);
         assert_eq!(log[2], json!(1.0));
-        assert!(spaced(&Range { start: 0.0, stop: 1.0, num: 3 }, "k", true).is_err());
-        assert_eq!(spaced(&Range { start: 0.0, stop: 1.0, num: 0 }, "k", false).unwrap_err().key, "k.num");
+        assert!(
+            spaced(
+                &Range {
+                    start: 0.0,
+                    stop: 1.0,
+                    num: 3
+                },
+                "k",
+                true
+            )
+            .is_err()
+        );
+        assert_eq!(
+            spaced(
+                &Range {
+                    start: 0.0,
+                    stop: 1.0,
+                    num: 0
+                },
+                "k",
+                false
+            )
+            .unwrap_err()
+            .key,
+            "k.num"
+        );
     }
 
     #[test]
     fn paths_parse_in_both_spellings() {
-        assert_eq!(canonical_path("walls.0.drum.rotation_rpm").unwrap(), "walls[0].drum.rotation_rpm");
-        assert_eq!(canonical_path("fill[1].random.lo_m[2]").unwrap(), "fill[1].random.lo_m[2]");
+        assert_eq!(
+            canonical_path("walls.0.drum.rotation_rpm").unwrap(),
+            "walls[0].drum.rotation_rpm"
+        );
+        assert_eq!(
+            canonical_path("fill[1].random.lo_m[2]").unwrap(),
+            "fill[1].random.lo_m[2]"
+        );
         assert!(canonical_path("a..b").is_err());
         assert!(canonical_path("a[x]").is_err());
         assert!(canonical_path("").is_err());

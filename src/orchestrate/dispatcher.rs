@@ -109,7 +109,12 @@ pub fn run_campaign(campaign: &Campaign, source: &Path, out: &Path, opts: &Dispa
     let mut store = Store::open(database_path(out)).map_err(store_err)?;
     let spec_hash = format!("{:016x}", xxhash_rust::xxh3::xxh3_64(campaign.yaml.as_bytes()));
     let campaign_id = store
-        .upsert_campaign(&campaign.spec.name, &campaign.yaml, &spec_hash, env!("CARGO_PKG_VERSION"))
+        .upsert_campaign(
+            &campaign.spec.name,
+            &campaign.yaml,
+            &spec_hash,
+            env!("CARGO_PKG_VERSION"),
+        )
         .map_err(store_err)?;
     let new_jobs: Vec<NewJob> = campaign
         .jobs
@@ -189,8 +194,21 @@ pub fn run_campaign(campaign: &Campaign, source: &Path, out: &Path, opts: &Dispa
         .build()
         .map_err(|e| Error::External(format!("cannot start the dispatcher's runtime: {e}")))?;
     let attempts: HashMap<String, u32> = rows.iter().map(|(id, r)| (id.clone(), r.attempt)).collect();
-    let labels: HashMap<String, String> = campaign.jobs.iter().map(|j| (j.job_id.clone(), campaign.label(j))).collect();
-    let interrupted = runtime.block_on(dispatch(&mut store, queue, attempts, &labels, &settings, progress))?;
+    let labels: HashMap<String, String> = campaign
+        .jobs
+        .iter()
+        .map(|j| (j.job_id.clone(), campaign.label(j)))
+        .collect();
+    let retries_used = store.retries_used(campaign_id).map_err(store_err)?;
+    let interrupted = runtime.block_on(dispatch(
+        &mut store,
+        queue,
+        attempts,
+        retries_used,
+        &labels,
+        &settings,
+        progress,
+    ))?;
 
     let counts = store.status_counts(campaign_id).map_err(store_err)?;
     let count = |s: JobStatus| counts.get(s.as_str()).copied().unwrap_or(0);
@@ -198,7 +216,12 @@ pub fn run_campaign(campaign: &Campaign, source: &Path, out: &Path, opts: &Dispa
     outcome.failed = count(JobStatus::Failed);
     outcome.pending = count(JobStatus::Pending) + count(JobStatus::Running);
     outcome.interrupted = interrupted;
-    tracing::info!(done = outcome.done, failed = outcome.failed, pending = outcome.pending, "dispatcher stopped");
+    tracing::info!(
+        done = outcome.done,
+        failed = outcome.failed,
+        pending = outcome.pending,
+        "dispatcher stopped"
+    );
     Ok(outcome)
 }
 
@@ -241,7 +264,9 @@ fn check_no_orphans(campaign: &Campaign, out: &Path) -> Result<(), Error> {
 /// without quotes).
 fn param_value(v: &serde_json::Value) -> ParamValue {
     match v {
-        serde_json::Value::Number(n) => n.as_f64().map_or_else(|| ParamValue::Text(n.to_string()), ParamValue::Real),
+        serde_json::Value::Number(n) => n
+            .as_f64()
+            .map_or_else(|| ParamValue::Text(n.to_string()), ParamValue::Real),
         serde_json::Value::String(s) => ParamValue::Text(s.clone()),
         other => ParamValue::Text(other.to_string()),
     }
@@ -302,13 +327,13 @@ async fn dispatch(
     store: &mut Store,
     mut queue: VecDeque<JobSpec>,
     mut attempts: HashMap<String, u32>,
+    mut retries_used: HashMap<(String, String), u32>,
     labels: &HashMap<String, String>,
     settings: &Settings,
     mut progress: Progress,
 ) -> Result<bool, Error> {
     let (tx, mut rx) = mpsc::unbounded_channel::<FromWorker>();
     let mut running: BTreeMap<String, Running> = BTreeMap::new();
-    let mut retries_used: HashMap<(String, &'static str), u32> = HashMap::new();
     let mut interrupts = 0u32;
     let mut sigint = tokio::signal::unix::signal(tokio::signal::unix::SignalKind::interrupt())
         .map_err(|e| Error::External(format!("cannot handle SIGINT: {e}")))?;
@@ -320,7 +345,12 @@ async fn dispatch(
             let Some(job) = queue.pop_front() else { break };
             let attempt = attempts.get(&job.job_id).copied().unwrap_or(0) + 1;
             attempts.insert(job.job_id.clone(), attempt);
-            match spawn(&job, settings, tx.clone()) {
+            let dt_halvings = if settings.retry.halve_dt_on_numerical {
+                retries_used.get(&(job.job_id.clone(), "numerical".to_string())).copied().unwrap_or(0)
+            } else {
+                0
+            };
+            match spawn(&job, settings, dt_halvings, tx.clone()) {
                 Ok((child_pid, stdin)) => {
                     store
                         .mark_running(&job.job_id, attempt, &hostname(), store::unix_time_s())
@@ -395,7 +425,7 @@ async fn dispatch(
                         "preempted" | "interrupted" | "locked" => AfterFailure::Retry,
                         "config" => AfterFailure::Final,
                         other => {
-                            let used = retries_used.entry((job_id.clone(), other)).or_insert(0);
+                            let used = retries_used.entry((job_id.clone(), other.to_string())).or_insert(0);
                             let budget = budget(&settings.retry, other);
                             if *used < budget { *used += 1; AfterFailure::Retry } else { AfterFailure::Final }
                         }
@@ -486,6 +516,7 @@ fn hostname() -> String {
 fn spawn(
     job: &JobSpec,
     settings: &Settings,
+    dt_halvings: u32,
     tx: mpsc::UnboundedSender<FromWorker>,
 ) -> Result<(Option<u32>, Option<ChildStdin>), Error> {
     let dir = job_dir(&settings.out, &job.job_id);
@@ -501,6 +532,8 @@ fn spawn(
         .arg(&dir)
         .arg("--threads")
         .arg(settings.threads.to_string())
+        .arg("--dt-halvings")
+        .arg(dt_halvings.to_string())
         .arg("--watch-stdin")
         .stdin(Stdio::piped())
         .stdout(Stdio::piped())

@@ -165,13 +165,24 @@ impl Progress {
             *last = Instant::now();
             let running: Vec<String> = progress
                 .iter()
-                .map(|(id, (s, t, r))| format!("{} {:.0}% ({r:.0} steps/s)", &id[..8.min(id.len())], 100.0 * *s as f64 / *t as f64))
+                .map(|(id, (s, t, r))| {
+                    format!(
+                        "{} {:.0}% ({r:.0} steps/s)",
+                        &id[..8.min(id.len())],
+                        100.0 * *s as f64 / *t as f64
+                    )
+                })
                 .collect();
             eprintln!(
                 "{done}/{total} done, {failed} failed, {} running{}{}",
                 running.len(),
-                eta.map(|e| format!(", ETA {:.0} s", e.as_secs_f64())).unwrap_or_default(),
-                if running.is_empty() { String::new() } else { format!(": {}", running.join(", ")) }
+                eta.map(|e| format!(", ETA {:.0} s", e.as_secs_f64()))
+                    .unwrap_or_default(),
+                if running.is_empty() {
+                    String::new()
+                } else {
+                    format!(": {}", running.join(", "))
+                }
             );
         }
     }

@@ -68,7 +68,9 @@ impl Message {
 
     /// Parses one line; `None` for lines that are not messages of this protocol version.
     pub fn parse(line: &str) -> Option<Message> {
-        serde_json::from_str::<Message>(line).ok().filter(|m| m.v == PROTOCOL_VERSION)
+        serde_json::from_str::<Message>(line)
+            .ok()
+            .filter(|m| m.v == PROTOCOL_VERSION)
     }
 }
 
@@ -85,7 +87,10 @@ mod tests {
             steps_per_s: 5.0,
         });
         let line = m.to_line();
-        assert!(line.contains("\"v\":1") && line.contains("\"event\":\"progress\""), "{line}");
+        assert!(
+            line.contains("\"v\":1") && line.contains("\"event\":\"progress\""),
+            "{line}"
+        );
         assert_eq!(Message::parse(&line), Some(m));
         assert_eq!(Message::parse(&line.replace("\"v\":1", "\"v\":2")), None);
         assert_eq!(Message::parse("warning: something"), None);

@@ -339,6 +339,26 @@ fn build_walls(
                 c.finite3(&key("axis_point_m"), &d.axis_point_m)?;
                 let axis = c.unit3(&key("axis"), &d.axis)?;
                 c.positive(&key("radius_m"), d.radius_m)?;
+                // The drum's cross-section must lie in the box on every non-periodic axis across its axis: outside
+                // the box a particle is lost, so a drum larger than the domain fails the run instead of confining it.
+                // (Along an axis the drum's axis is not perpendicular to, the cylinder is unbounded and the box
+                // caps it.)
+                for a in 0..3 {
+                    if domain.periodic[a] || axis[a].abs() > 1e-9 {
+                        continue;
+                    }
+                    let (lo, hi) = (d.axis_point_m[a] - d.radius_m, d.axis_point_m[a] + d.radius_m);
+                    if lo < domain.lo_m[a] || hi > domain.hi_m[a] {
+                        let axis_name = ["x", "y", "z"][a];
+                        return Err(c.fail(
+                            key("radius_m"),
+                            format!(
+                                "expected the drum inside the domain along {axis_name} ({} to {} m), got {lo} to {hi} m (axis point {} m, radius {} m)",
+                                domain.lo_m[a], domain.hi_m[a], d.axis_point_m[a], d.radius_m
+                            ),
+                        ));
+                    }
+                }
                 if !d.rotation_rpm.is_finite() {
                     return Err(c.fail(
                         key("rotation_rpm"),
@@ -645,6 +665,12 @@ fn fill(
                     ));
                 }
                 let placed = random_insert(&mut particles, id, sp, *count as usize, lo_m, hi_m, walls, domain, rng);
+                if placed == 0 {
+                    return Err(c.fail(
+                        format!("fill[{k}].random"),
+                        "no particle fits: the region lies outside the walls or the box",
+                    ));
+                }
                 if placed < *count as usize {
                     return Err(c.fail(
                         key("count"),

@@ -55,20 +55,21 @@ pub fn parse_yaml<T: serde::de::DeserializeOwned>(text: &str, path: &Path) -> Re
     })
 }
 
-/// Appends "did you mean `x`?" to serde's "unknown field `y`, expected one of `a`, `b`" when one is close.
+/// Appends "did you mean `x`?" to serde's "unknown field `y`, expected one of `a`, `b`" (or "unknown variant")
+/// when one of the known names is close.
 pub fn with_suggestion(message: String) -> String {
-    let Some(rest) = message.strip_prefix("unknown field `").or_else(|| {
-        message
-            .find("unknown field `")
-            .map(|i| &message[i + "unknown field `".len()..])
-    }) else {
+    let Some(rest) = ["unknown field `", "unknown variant `"]
+        .iter()
+        .find_map(|prefix| message.find(prefix).map(|i| &message[i + prefix.len()..]))
+    else {
         return message;
     };
     let Some(end) = rest.find('`') else {
         return message;
     };
     let word = &rest[..end];
-    let known: Vec<&str> = rest[end..].split('`').skip(1).step_by(2).collect();
+    // After the word: "`, expected one of `a`, `b` at line ..." — the names are every other piece between backticks.
+    let known: Vec<&str> = rest[end..].split('`').skip(2).step_by(2).collect();
     match crate::campaign::sweep::did_you_mean(word, &known) {
         Some(k) if k != word => format!("{message}; did you mean `{k}`?"),
         _ => message,

@@ -71,6 +71,25 @@ impl Store {
         Ok(counts)
     }
 
+    /// Retries already used, per (job, failure class): attempts that ended `requeued` with that class. The
+    /// dispatcher starts from these counts, so a retry budget is not renewed by restarting the dispatcher.
+    pub fn retries_used(&self, campaign_id: i64) -> Result<HashMap<(String, String), u32>, StoreError> {
+        let action = format_args!("counting the retries of campaign {campaign_id}");
+        let mut stmt = self
+            .conn
+            .prepare_cached(
+                "SELECT a.job_id, a.exit_class, count(*) FROM attempts a JOIN jobs j ON j.job_id = a.job_id
+                 WHERE j.campaign_id = ?1 AND a.outcome = 'requeued' AND a.exit_class IS NOT NULL
+                 GROUP BY a.job_id, a.exit_class",
+            )
+            .context(&self.path, action)?;
+        stmt.query_map([campaign_id], |row| {
+            Ok(((row.get::<_, String>(0)?, row.get::<_, String>(1)?), row.get::<_, i64>(2)?.max(0) as u32))
+        })
+        .and_then(|rows| rows.collect())
+        .context(&self.path, action)
+    }
+
     /// The ids of the campaign's `done` jobs, which `run` and `resume` skip.
     pub fn done_job_ids(&self, campaign_id: i64) -> Result<HashSet<String>, StoreError> {
         let action = format_args!("listing the done jobs of campaign {campaign_id}");

@@ -51,6 +51,8 @@ pub struct JobResult {
 pub struct WorkerOptions {
     pub job_dir: PathBuf,
     pub threads: usize,
+    /// Halve the scenario's time step this many times (a retry after a numerical failure).
+    pub dt_halvings: u32,
     pub watch_stdin: bool,
     /// Stop (with a checkpoint) after this many steps in this invocation; for tests.
     pub max_steps: Option<u64>,
@@ -132,6 +134,7 @@ fn run(opts: &WorkerOptions) -> Result<i32, Error> {
         dir,
         RunControl {
             threads: opts.threads,
+            dt_halvings: opts.dt_halvings,
             max_steps: opts.max_steps,
             quiet: true,
             stop: Some(&stop),

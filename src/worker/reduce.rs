@@ -23,7 +23,11 @@ pub struct Metric {
 }
 
 fn nan_as_null<S: serde::Serializer>(v: &f64, s: S) -> Result<S::Ok, S::Error> {
-    if v.is_finite() { s.serialize_f64(*v) } else { s.serialize_none() }
+    if v.is_finite() {
+        s.serialize_f64(*v)
+    } else {
+        s.serialize_none()
+    }
 }
 
 fn null_as_nan<'de, D: serde::Deserializer<'de>>(d: D) -> Result<f64, D::Error> {
@@ -63,7 +67,7 @@ impl MixingSampler {
 
     /// The extra series columns for the current state (`nan` between mixing samples).
     pub fn row(&mut self, sim: &Simulation) -> String {
-        if self.every_steps.is_some_and(|k| sim.step % k != 0) {
+        if self.every_steps.is_some_and(|k| !sim.step.is_multiple_of(k)) {
             return ",nan,nan".to_string();
         }
         let m = self.state(sim);
@@ -198,7 +202,10 @@ fn layered_granular_temperature(sim: &Simulation) -> f64 {
         let lo = p.position_m.iter().map(|x| x[axis]).fold(f64::INFINITY, f64::min);
         let hi = p.position_m.iter().map(|x| x[axis]).fold(f64::NEG_INFINITY, f64::max);
         let layers = (((hi - lo) / (4.0 * p.max_radius_m())).ceil() as usize).max(1);
-        (analysis::granular::layer_bins(&p.position_m, axis, lo, hi, layers), layers)
+        (
+            analysis::granular::layer_bins(&p.position_m, axis, lo, hi, layers),
+            layers,
+        )
     };
     analysis::granular_temperature(&p.velocity_m_per_s, &bins, count).mean_m2_per_s2
 }
