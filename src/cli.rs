@@ -49,6 +49,8 @@ pub enum Command {
     },
     /// List every model name with its parameters and units.
     Models,
+    /// Print the JSON Schema of the campaign file (also in schemas/campaign.schema.json).
+    Schema,
     /// Run a campaign: expand its sweep, run the jobs in worker processes, store their metrics.
     Run {
         campaign: PathBuf,
@@ -233,6 +235,13 @@ pub fn run(cli: Cli) -> Result<i32> {
             which: BenchCommand::Campaign { jobs, max_parallel },
         } => crate::bench_campaign::bench_campaign(&crate::bench_campaign::CampaignBenchOptions { jobs, max_parallel })
             .map(|()| 0),
+        Command::Schema => {
+            println!(
+                "{}",
+                serde_json::to_string_pretty(&crate::campaign::json_schema()).expect("a schema serialises")
+            );
+            Ok(0)
+        }
         Command::Models => {
             print!("{}", crate::models_doc::MODELS);
             Ok(0)

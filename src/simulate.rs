@@ -264,7 +264,10 @@ pub fn run_in_dir(built: &BuiltScenario, out: &Path, ctl: RunControl) -> Result<
         let dt_s = built.dt_s / f64::from(1u32 << dt_halvings.min(30));
         if sim.dt_s != dt_s {
             if !quiet {
-                eprintln!("time step {:.3e} s → {:.3e} s ({dt_halvings} halving(s))", sim.dt_s, dt_s);
+                eprintln!(
+                    "time step {:.3e} s → {:.3e} s ({dt_halvings} halving(s))",
+                    sim.dt_s, dt_s
+                );
             }
             sim.dt_s = dt_s;
         }

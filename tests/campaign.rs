@@ -287,12 +287,26 @@ retry: { numerical: 2 }
     let tmp = tempfile::tempdir().unwrap();
     let file = write(tmp.path(), "numerical.yaml", yaml);
     let out = tmp.path().join("out");
-    ok(&["run", file.to_str().unwrap(), "--out", out.to_str().unwrap(), "--quiet"], tmp.path());
+    ok(
+        &["run", file.to_str().unwrap(), "--out", out.to_str().unwrap(), "--quiet"],
+        tmp.path(),
+    );
     assert!(sql(&out, "SELECT COUNT(*) FROM jobs WHERE status = 'done'").contains('2'));
-    let requeued = sql(&out, "SELECT COUNT(*) FROM attempts WHERE outcome = 'requeued' AND exit_class = 'numerical'");
-    assert_eq!(requeued.lines().nth(1), Some("2"), "one numerical retry per job: {requeued}");
+    let requeued = sql(
+        &out,
+        "SELECT COUNT(*) FROM attempts WHERE outcome = 'requeued' AND exit_class = 'numerical'",
+    );
+    assert_eq!(
+        requeued.lines().nth(1),
+        Some("2"),
+        "one numerical retry per job: {requeued}"
+    );
     for id in sql(&out, "SELECT job_id FROM jobs").lines().skip(1) {
-        let state = CheckpointSeries::new(&out.join("jobs").join(id.trim()), 2).latest_valid().unwrap().unwrap().state;
+        let state = CheckpointSeries::new(out.join("jobs").join(id.trim()), 2)
+            .latest_valid()
+            .unwrap()
+            .unwrap()
+            .state;
         assert_eq!(state.dt_s, 1.5e-4, "the retry ran with the time step halved");
     }
 }

@@ -317,6 +317,22 @@ pub fn validate_jobs<'a>(jobs: impl IntoIterator<Item = &'a JobSpec>, path: &Pat
     Ok(())
 }
 
+/// The JSON Schema of the campaign file, generated from the types that parse it (`schemas/campaign.schema.json` is
+/// this, checked by a test).
+pub fn json_schema() -> serde_json::Value {
+    let mut schema = serde_json::to_value(schemars::schema_for!(CampaignSpec)).expect("a schema serialises");
+    if let Some(map) = schema.as_object_mut() {
+        map.insert("title".into(), "granflow campaign".into());
+        map.insert(
+            "description".into(),
+            "A granflow campaign file: a base scenario, a sweep over its parameters, metrics, executor and retry \
+             settings. Generated from the code (`granflow schema`)."
+                .into(),
+        );
+    }
+    schema
+}
+
 /// The output directory of a campaign: `--out` if given, else `results/<name>`.
 pub fn output_dir(spec: &CampaignSpec, out: Option<&Path>) -> PathBuf {
     out.map_or_else(|| PathBuf::from("results").join(&spec.name), Path::to_path_buf)

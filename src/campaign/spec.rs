@@ -5,7 +5,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::scenario::ScenarioSpec;
 
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, schemars::JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct CampaignSpec {
     /// Also the default output directory, `results/<name>/`. Letters, digits, `-`, `_` and `.` only.
@@ -54,7 +54,7 @@ fn default_max_jobs() -> usize {
 /// - `grid`: the Cartesian product of its children (in order, the last varying fastest);
 /// - `zip`: its children side by side (all of the same length);
 /// - `list`: explicit points, each a map from parameter path to value.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, Default)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, Default, schemars::JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct SweepNode {
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -78,7 +78,7 @@ pub struct SweepNode {
 
 /// `num` points from `start` to `stop` inclusive: evenly spaced (`linspace`) or geometrically (`logspace`; `start`
 /// and `stop` are the end values themselves, not their logarithms).
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize, schemars::JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct Range {
     pub start: f64,
@@ -86,7 +86,7 @@ pub struct Range {
     pub num: usize,
 }
 
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, schemars::JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct AnalysisSpec {
     /// Binary mixing: which species is "A" for the intensity of segregation and the Lacey index.
@@ -114,7 +114,7 @@ impl Default for AnalysisSpec {
     }
 }
 
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, schemars::JsonSchema)]
 #[serde(rename_all = "snake_case", deny_unknown_fields)]
 pub enum ExecutorSpec {
     /// Worker processes on this machine.
@@ -127,7 +127,7 @@ impl Default for ExecutorSpec {
     }
 }
 
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, schemars::JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct LocalExecutor {
     /// Workers at once. Default: the number of cores divided by `threads_per_job`.
@@ -162,7 +162,7 @@ impl Default for LocalExecutor {
     }
 }
 
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, schemars::JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct CheckpointPolicy {
     #[serde(default = "default_checkpoint_every")]
@@ -189,7 +189,7 @@ impl Default for CheckpointPolicy {
 
 /// Extra attempts allowed per failure class. A configuration error never retries; a preempted job (stopped by a
 /// signal after checkpointing) is requeued without using an attempt.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, schemars::JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct RetryPolicy {
     /// Non-finite values, excessive overlap, lost particle.

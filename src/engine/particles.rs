@@ -11,7 +11,7 @@ use serde::{Deserialize, Serialize};
 use super::Vec3;
 
 /// Stable identity of a particle. Never reused within one simulation.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash, Serialize, Deserialize, schemars::JsonSchema)]
 pub struct ParticleId(pub u32);
 
 impl ParticleId {
@@ -21,7 +21,7 @@ impl ParticleId {
 }
 
 /// Index of a species in the [`SpeciesTable`].
-#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash, Serialize, Deserialize, schemars::JsonSchema)]
 pub struct SpeciesId(pub u16);
 
 impl SpeciesId {
@@ -31,7 +31,7 @@ impl SpeciesId {
 }
 
 /// A particle material. Walls are species too (with an infinite radius, see `geometry::walls`).
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, schemars::JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct Species {
     pub name: String,
@@ -64,7 +64,7 @@ impl Species {
 }
 
 /// All species of a simulation, indexed by [`SpeciesId`].
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, Default)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, Default, schemars::JsonSchema)]
 pub struct SpeciesTable {
     pub species: Vec<Species>,
 }

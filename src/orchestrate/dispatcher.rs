@@ -346,7 +346,10 @@ async fn dispatch(
             let attempt = attempts.get(&job.job_id).copied().unwrap_or(0) + 1;
             attempts.insert(job.job_id.clone(), attempt);
             let dt_halvings = if settings.retry.halve_dt_on_numerical {
-                retries_used.get(&(job.job_id.clone(), "numerical".to_string())).copied().unwrap_or(0)
+                retries_used
+                    .get(&(job.job_id.clone(), "numerical".to_string()))
+                    .copied()
+                    .unwrap_or(0)
             } else {
                 0
             };

@@ -7,7 +7,7 @@ use crate::engine::geometry::Gravity;
 use crate::engine::models::ContactLaw;
 use crate::engine::particles::Species;
 
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, schemars::JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct ScenarioSpec {
     /// Required in a scenario file; in a campaign's `base` the campaign fills it in.
@@ -42,7 +42,7 @@ fn default_max_overlap_fraction() -> f64 {
     0.25
 }
 
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, schemars::JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct DomainSpec {
     pub lo_m: [f64; 3],
@@ -51,7 +51,7 @@ pub struct DomainSpec {
     pub periodic: [bool; 3],
 }
 
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, schemars::JsonSchema)]
 #[serde(rename_all = "snake_case", deny_unknown_fields)]
 pub enum WallSpec {
     /// Plane walls on the faces of the domain along every non-periodic axis.
@@ -67,7 +67,7 @@ pub enum WallSpec {
     Drum(DrumSpec),
 }
 
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, schemars::JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct DrumSpec {
     pub name: String,
@@ -83,7 +83,7 @@ pub struct DrumSpec {
 
 /// Baffle plates fixed to a drum (seed 000 §3.4, Fig. 23). Coordinates are in the plane normal to the drum axis,
 /// relative to the axis, at drum angle 0.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, schemars::JsonSchema)]
 #[serde(rename_all = "snake_case", deny_unknown_fields)]
 pub enum BaffleSpec {
     /// `count` plates attached to the wall at equal angles, reaching `length_m` inwards; `tilt_deg` = 0 is a
@@ -112,7 +112,7 @@ pub enum BaffleSpec {
     },
 }
 
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, schemars::JsonSchema)]
 #[serde(rename_all = "snake_case", deny_unknown_fields)]
 pub enum FillSpec {
     /// Particles on a simple-cubic lattice: points `origin_m + k·spacing_m` inside [lo_m, hi_m) (the LAMMPS
@@ -149,7 +149,7 @@ pub enum FillSpec {
     },
 }
 
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, schemars::JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct TimeSpec {
     pub end_time_s: f64,
@@ -168,7 +168,7 @@ fn default_reference_velocity() -> f64 {
     1.0
 }
 
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, Default)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, Default, schemars::JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct NeighborSpec {
     /// Neighbour-list skin. Default: 0.4 × the largest particle radius (0.6 mm for the 1.5 mm benchmark spheres,
@@ -177,7 +177,7 @@ pub struct NeighborSpec {
     pub skin_m: Option<f64>,
 }
 
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, schemars::JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct OutputSpec {
     #[serde(default = "default_checkpoint_every")]

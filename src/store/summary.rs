@@ -84,7 +84,10 @@ impl Store {
             )
             .context(&self.path, action)?;
         stmt.query_map([campaign_id], |row| {
-            Ok(((row.get::<_, String>(0)?, row.get::<_, String>(1)?), row.get::<_, i64>(2)?.max(0) as u32))
+            Ok((
+                (row.get::<_, String>(0)?, row.get::<_, String>(1)?),
+                row.get::<_, i64>(2)?.max(0) as u32,
+            ))
         })
         .and_then(|rows| rows.collect())
         .context(&self.path, action)

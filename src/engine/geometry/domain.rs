@@ -78,7 +78,7 @@ impl Domain {
 }
 
 /// Axis names for configuration.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, schemars::JsonSchema)]
 #[serde(rename_all = "snake_case")]
 pub enum Axis {
     X,
@@ -97,7 +97,7 @@ impl Axis {
 }
 
 /// Gravity, optionally with one component flipping sign as a square wave (seed 000 §3.2, the zig-zag chute).
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize, schemars::JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct Gravity {
     pub vector_m_per_s2: [f64; 3],
@@ -105,7 +105,7 @@ pub struct Gravity {
     pub flip: Option<GravityFlip>,
 }
 
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize, schemars::JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct GravityFlip {
     /// The component that flips sign.

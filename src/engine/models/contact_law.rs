@@ -14,7 +14,7 @@ use super::tangential::TangentialModel;
 use crate::engine::Vec3;
 use crate::engine::contacts::HistoryLayout;
 
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize, schemars::JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct ContactLaw {
     pub normal: NormalModel,

@@ -13,7 +13,7 @@ use super::pair_table::PairMaterial;
 /// √(5/6), from the Tsuji/LIGGGHTS viscoelastic damping coefficient.
 const SQRT_FIVE_SIXTHS: f64 = 0.912_870_929_175_276_8;
 
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize, schemars::JsonSchema)]
 #[serde(rename_all = "snake_case", deny_unknown_fields)]
 pub enum NormalModel {
     /// F_n = K_n δ − η_n v_n (seed 001 eq. 6.16 with the dissipative sign of its Appendix B; seed 002 eq. 21).
@@ -33,7 +33,7 @@ pub enum NormalModel {
 }
 
 /// Slope k_y of Thornton's plastic loading branch, as a multiple of F_y/α_y.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default, schemars::JsonSchema)]
 #[serde(rename_all = "snake_case")]
 pub enum PlasticSlope {
     /// k_y = (3/2) F_y/α_y = π p_y R*: Thornton's (1997) perfectly plastic slope, continuous with the Hertz slope at

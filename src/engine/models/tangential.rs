@@ -12,7 +12,7 @@ use super::normal::NormalOutput;
 use super::pair_table::PairMaterial;
 use crate::engine::Vec3;
 
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize, schemars::JsonSchema)]
 #[serde(rename_all = "snake_case", deny_unknown_fields)]
 pub enum TangentialModel {
     /// Linear spring on the accumulated elastic displacement u_t with a dashpot, truncated at μF_n
