@@ -177,7 +177,16 @@ fn worker_killed_after(dir: &Path, delay: Duration) -> bool {
 #[test]
 fn workers_killed_at_random_moments_resume_bit_identically() {
     let tmp = tempfile::tempdir().unwrap();
-    let file = write(tmp.path(), "mini.yaml", &campaign("[60.0]", 8.0));
+    // GRANFLOW_KILL_TRIALS asks for more kills (scripts/kill-test.sh); the job is made long enough for them.
+    let trials: usize = std::env::var("GRANFLOW_KILL_TRIALS")
+        .ok()
+        .and_then(|s| s.parse().ok())
+        .unwrap_or(10);
+    let file = write(
+        tmp.path(),
+        "mini.yaml",
+        &campaign("[60.0]", (0.8 * trials as f64).max(8.0)),
+    );
     let reference = tmp.path().join("reference");
     ok(
         &[
@@ -202,7 +211,7 @@ fn workers_killed_at_random_moments_resume_bit_identically() {
     std::fs::copy(ref_dir.join("job.json"), dir.join("job.json")).unwrap();
     let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(11);
     let mut kills = 0;
-    for _ in 0..40 {
+    for _ in 0..4 * trials.max(10) {
         if dir.join("result.json").exists() {
             break;
         }
@@ -236,6 +245,20 @@ fn workers_killed_at_random_moments_resume_bit_identically() {
     assert_eq!(series(&dir), series(&ref_dir), "time series after {kills} kills");
 }
 
+/// Command lines of running processes that contain `needle` (read from /proc, so no procps is needed).
+fn processes_mentioning(needle: &str) -> Vec<String> {
+    let mut found = Vec::new();
+    for entry in std::fs::read_dir("/proc").unwrap().flatten() {
+        if let Ok(cmdline) = std::fs::read(entry.path().join("cmdline")) {
+            let text = String::from_utf8_lossy(&cmdline).replace('\0', " ");
+            if text.contains(needle) {
+                found.push(text);
+            }
+        }
+    }
+    found
+}
+
 #[test]
 fn killing_the_dispatcher_loses_nothing_and_resume_finishes() {
     let tmp = tempfile::tempdir().unwrap();
@@ -250,8 +273,10 @@ fn killing_the_dispatcher_loses_nothing_and_resume_finishes() {
     std::thread::sleep(Duration::from_millis(1500));
     dispatcher.kill().unwrap();
     dispatcher.wait().unwrap();
-    // Its workers notice (their stdin closes) and stop at once: nobody holds a job lock for long.
+    // Its workers notice (their stdin closes) and stop at once.
     std::thread::sleep(Duration::from_millis(500));
+    let left = processes_mentioning(out.join("jobs").to_str().unwrap());
+    assert!(left.is_empty(), "workers outlived their dispatcher: {left:?}");
     ok(&["resume", out.to_str().unwrap(), "--quiet"], tmp.path());
     assert!(sql(&out, "SELECT COUNT(*) FROM jobs WHERE status = 'done'").contains('4'));
     assert!(
@@ -309,4 +334,85 @@ retry: { numerical: 2 }
             .state;
         assert_eq!(state.dt_s, 1.5e-4, "the retry ran with the time step halved");
     }
+}
+
+#[test]
+fn ctrl_c_checkpoints_and_stops_then_resume_finishes_and_a_second_dispatcher_is_refused() {
+    let tmp = tempfile::tempdir().unwrap();
+    let file = write(tmp.path(), "mini.yaml", &campaign("[20.0, 60.0]", 3.0));
+    let out = tmp.path().join("out");
+    let mut dispatcher = Command::new(env!("CARGO_BIN_EXE_granflow"))
+        .args(["run", file.to_str().unwrap(), "--out", out.to_str().unwrap(), "--quiet"])
+        .stdout(Stdio::null())
+        .stderr(Stdio::null())
+        .spawn()
+        .unwrap();
+    std::thread::sleep(Duration::from_millis(1200));
+
+    // One dispatcher per campaign directory.
+    let second = granflow(&["resume", out.to_str().unwrap(), "--quiet"], tmp.path());
+    assert!(!second.status.success());
+    assert!(
+        String::from_utf8_lossy(&second.stderr).contains("another dispatcher"),
+        "{}",
+        String::from_utf8_lossy(&second.stderr)
+    );
+
+    nix::sys::signal::kill(
+        nix::unistd::Pid::from_raw(dispatcher.id() as i32),
+        nix::sys::signal::Signal::SIGINT,
+    )
+    .unwrap();
+    let status = dispatcher.wait().unwrap();
+    assert_eq!(status.code(), Some(130), "interrupted");
+    let states = sql(&out, "SELECT status, COUNT(*) FROM jobs GROUP BY status");
+    assert!(!states.contains("failed") && !states.contains("running"), "{states}");
+    let stopped = sql(&out, "SELECT COUNT(*) FROM attempts WHERE exit_class = 'interrupted'");
+    assert_ne!(
+        stopped.lines().nth(1),
+        Some("0"),
+        "running workers were stopped: {stopped}"
+    );
+    // The stopped workers kept their progress: a checkpoint beyond the start.
+    let pending = sql(&out, "SELECT job_id FROM jobs WHERE status = 'pending'");
+    let progressed = pending.lines().skip(1).any(|id| {
+        CheckpointSeries::new(out.join("jobs").join(id.trim()), 2)
+            .latest_valid()
+            .unwrap()
+            .is_some_and(|c| c.state.step > 0)
+    });
+    assert!(progressed, "an interrupted job checkpointed its progress: {pending}");
+    ok(&["resume", out.to_str().unwrap(), "--quiet"], tmp.path());
+    assert!(sql(&out, "SELECT COUNT(*) FROM jobs WHERE status = 'done'").contains('4'));
+}
+
+#[test]
+fn a_job_over_its_time_limit_is_stopped_and_failed_as_a_timeout() {
+    let tmp = tempfile::tempdir().unwrap();
+    let text = campaign("[20.0]", 60.0).replace(
+        "executor: { local: { max_parallel: 2 } }",
+        "executor: { local: { max_parallel: 2, job_timeout_s: 0.5 } }",
+    );
+    let file = write(tmp.path(), "mini.yaml", &text);
+    let out = tmp.path().join("out");
+    let started = std::time::Instant::now();
+    let run = granflow(
+        &["run", file.to_str().unwrap(), "--out", out.to_str().unwrap(), "--quiet"],
+        tmp.path(),
+    );
+    assert_eq!(
+        run.status.code(),
+        Some(6),
+        "some jobs failed: {}",
+        String::from_utf8_lossy(&run.stderr)
+    );
+    assert!(
+        started.elapsed() < Duration::from_secs(30),
+        "stopped long before its 60 s of simulated time"
+    );
+    let failed = sql(
+        &out,
+        "SELECT exit_class, COUNT(*) FROM jobs WHERE status = 'failed' GROUP BY exit_class",
+    );
+    assert!(failed.contains("timeout,2"), "{failed}");
 }
