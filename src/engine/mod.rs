@@ -5,6 +5,7 @@
 pub mod contacts;
 pub mod error;
 pub mod forces;
+pub mod gas;
 pub mod geometry;
 pub mod integrate;
 pub mod models;

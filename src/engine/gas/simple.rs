@@ -1,0 +1,480 @@
+//! The volume-averaged gas equations (seed 000 eqs 2.23–2.24) on the staggered grid, implicit in time, solved by
+//! SIMPLE pressure correction (Patankar 1980; seed 000 §2.2.2, eqs 2.42–2.65):
+//!
+//! ∂(ερ_g)/∂t + ∇·(ερ_g u) = 0,
+//! ∂(ερ_g u)/∂t + ∇·(ερ_g uu) = −ε∇p − ∇·(ετ_g) + ερ_g g + S,
+//!
+//! with ρ_g constant, τ_g = −μ∇u (the ε-weighted Laplacian form), and S a momentum source per unit volume (the
+//! particles' reaction to drag, or a driving pressure gradient). Convection is upwind or hybrid (Spalding:
+//! central differences where the cell Péclet number is below 2, upwind above), diffusion central.
+//!
+//! Each time step: outer iterations of (momentum predictor with the current pressure → pressure correction from
+//! continuity → corrected pressure and velocities), under-relaxed, until the mass imbalance is below tolerance.
+//! Momentum systems go to BiCGStab, the pressure correction to conjugate gradients (both Jacobi-preconditioned).
+
+use serde::{Deserialize, Serialize};
+
+use super::grid::{Boundary, Grid, side};
+use super::linsolve::{NONE, SolveReport, StencilSystem, bicgstab, conjugate_gradient};
+
+/// The convection scheme.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Convection {
+    Upwind,
+    Hybrid,
+}
+
+/// Gas properties and numerical settings.
+#[derive(Debug, Clone, PartialEq)]
+pub struct GasConfig {
+    pub grid: Grid,
+    pub density_kg_per_m3: f64,
+    pub viscosity_pa_s: f64,
+    pub gravity_m_per_s2: [f64; 3],
+    pub convection: Convection,
+    /// Under-relaxation of the momentum predictor (0–1].
+    pub relax_velocity: f64,
+    /// Under-relaxation of the pressure correction (0–1].
+    pub relax_pressure: f64,
+    pub max_outer_iterations: usize,
+    /// Outer iterations stop when the mass imbalance, relative to the total face mass flow, is below this ...
+    pub mass_tolerance: f64,
+    /// ... and the largest velocity change of the iteration, relative to the largest velocity, below this.
+    pub velocity_tolerance: f64,
+    pub linear_tolerance: f64,
+    pub max_linear_iterations: usize,
+}
+
+/// The gas state: everything a checkpoint needs.
+#[derive(Debug, Clone, PartialEq)]
+pub struct GasState {
+    /// Pressure at cell centres, Pa (relative: only its gradient acts when no boundary fixes it).
+    pub pressure_pa: Vec<f64>,
+    /// Velocity components on their faces, m/s: `velocity[a]` has `grid.faces(a)` values.
+    pub velocity_m_per_s: [Vec<f64>; 3],
+    /// Gas volume fraction ε at cell centres.
+    pub porosity: Vec<f64>,
+    pub time_s: f64,
+}
+
+/// How one gas step went.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct StepReport {
+    pub outer_iterations: usize,
+    pub mass_imbalance: f64,
+    /// Largest velocity change of the last outer iteration relative to the largest velocity.
+    pub velocity_change: f64,
+    pub converged: bool,
+    pub momentum: SolveReport,
+    pub pressure: SolveReport,
+}
+
+impl GasState {
+    pub fn new(grid: &Grid) -> Self {
+        GasState {
+            pressure_pa: vec![0.0; grid.cells()],
+            velocity_m_per_s: std::array::from_fn(|a| vec![0.0; grid.faces(a)]),
+            porosity: vec![1.0; grid.cells()],
+            time_s: 0.0,
+        }
+    }
+}
+
+/// Index arithmetic with periodic wrapping: `i + delta` along `axis`, or `None` outside a non-periodic grid.
+fn step_cell(grid: &Grid, mut i: [usize; 3], axis: usize, delta: isize) -> Option<[usize; 3]> {
+    let n = grid.n[axis] as isize;
+    let j = i[axis] as isize + delta;
+    if (0..n).contains(&j) {
+        i[axis] = j as usize;
+        Some(i)
+    } else if grid.periodic(axis) {
+        i[axis] = j.rem_euclid(n) as usize;
+        Some(i)
+    } else {
+        None
+    }
+}
+
+fn all_indices(dims: [usize; 3]) -> impl Iterator<Item = [usize; 3]> {
+    (0..dims[2]).flat_map(move |k| (0..dims[1]).flat_map(move |j| (0..dims[0]).map(move |i| [i, j, k])))
+}
+
+/// Boundary velocity (all three components) on a side.
+fn side_velocity(b: Boundary) -> [f64; 3] {
+    match b {
+        Boundary::Wall { velocity_m_per_s } | Boundary::Inlet { velocity_m_per_s } => velocity_m_per_s,
+        Boundary::Periodic => [0.0; 3],
+    }
+}
+
+/// The gas solver: configuration, state, and the work arrays of the last step.
+pub struct GasSolver {
+    pub config: GasConfig,
+    pub state: GasState,
+    /// Per velocity component and face: the unknown's index in that component's system, or NONE (boundary/alias).
+    unknown: [Vec<u32>; 3],
+    /// Per component: the face of each unknown.
+    face_of: [Vec<usize>; 3],
+    /// Per component and face: ε_f A / a_P of the last momentum assembly (the pressure-correction coefficient).
+    d: [Vec<f64>; 3],
+}
+
+impl GasSolver {
+    pub fn new(config: GasConfig) -> Result<Self, String> {
+        config.grid.check()?;
+        let grid = &config.grid;
+        let mut unknown: [Vec<u32>; 3] = std::array::from_fn(|a| vec![NONE; grid.faces(a)]);
+        let mut face_of: [Vec<usize>; 3] = Default::default();
+        for a in 0..grid.axes() {
+            for idx in all_indices(grid.face_dims(a)) {
+                let along = idx[a];
+                let solved = if grid.periodic(a) {
+                    along < grid.n[a]
+                } else {
+                    along > 0 && along < grid.n[a]
+                };
+                if solved {
+                    let f = grid.face(a, idx);
+                    unknown[a][f] = face_of[a].len() as u32;
+                    face_of[a].push(f);
+                }
+            }
+        }
+        let d = std::array::from_fn(|a| vec![0.0; grid.faces(a)]);
+        let mut solver = GasSolver {
+            state: GasState::new(grid),
+            config,
+            unknown,
+            face_of,
+            d,
+        };
+        solver.apply_boundary_velocities();
+        Ok(solver)
+    }
+
+    /// Sets boundary-face normal velocities (walls 0, inlets their velocity) and periodic aliases.
+    fn apply_boundary_velocities(&mut self) {
+        let grid = &self.config.grid;
+        for a in 0..grid.axes() {
+            for idx in all_indices(grid.face_dims(a)) {
+                let along = idx[a];
+                let f = grid.face(a, idx);
+                if grid.periodic(a) {
+                    if along == grid.n[a] {
+                        let mut first = idx;
+                        first[a] = 0;
+                        self.state.velocity_m_per_s[a][f] = self.state.velocity_m_per_s[a][grid.face(a, first)];
+                    }
+                } else if along == 0 || along == grid.n[a] {
+                    let b = grid.boundary[side(a, along == grid.n[a])];
+                    self.state.velocity_m_per_s[a][f] = match b {
+                        Boundary::Inlet { velocity_m_per_s } => velocity_m_per_s[a],
+                        _ => 0.0,
+                    };
+                }
+            }
+        }
+    }
+
+    fn porosity_at_face(&self, a: usize, idx: [usize; 3]) -> f64 {
+        let grid = &self.config.grid;
+        let eps = &self.state.porosity;
+        let hi = (idx[a] < grid.n[a]).then_some(idx);
+        let lo = step_cell(grid, idx, a, -1).filter(|_| idx[a] > 0 || grid.periodic(a));
+        match (lo, hi) {
+            (Some(l), Some(h)) => 0.5 * (eps[grid.cell(l)] + eps[grid.cell(h)]),
+            (Some(l), None) => {
+                // The last face of a periodic axis is the first one.
+                let mut first = idx;
+                first[a] = 0;
+                if grid.periodic(a) {
+                    0.5 * (eps[grid.cell(l)] + eps[grid.cell(first)])
+                } else {
+                    eps[grid.cell(l)]
+                }
+            }
+            (None, Some(h)) => eps[grid.cell(h)],
+            (None, None) => 1.0,
+        }
+    }
+
+    /// Assembles the momentum system of component `c` and stores the pressure-correction coefficients.
+    fn assemble_momentum(&mut self, c: usize, dt_s: f64, old: &[f64], source: &[f64]) -> StencilSystem {
+        let cfg = &self.config;
+        let grid = &cfg.grid;
+        let (rho, mu) = (cfg.density_kg_per_m3, cfg.viscosity_pa_s);
+        let u = &self.state.velocity_m_per_s;
+        let eps = &self.state.porosity;
+        let p = &self.state.pressure_pa;
+        let volume = grid.cell_volume_m3();
+        let n_unknowns = self.face_of[c].len();
+        let mut sys = StencilSystem::new(n_unknowns);
+        let mut d = vec![0.0; grid.faces(c)];
+        let coefficient = |flux_into: f64, diff: f64| -> f64 {
+            // flux_into > 0: flow from the neighbour into the control volume.
+            match cfg.convection {
+                Convection::Upwind => diff + flux_into.max(0.0),
+                Convection::Hybrid => flux_into.max(diff + 0.5 * flux_into).max(0.0),
+            }
+        };
+        for (row, &f) in self.face_of[c].iter().enumerate() {
+            let idx = face_index(grid, c, f);
+            let i_c = idx[c];
+            let cell_hi = idx;
+            let cell_lo = step_cell(grid, idx, c, -1).expect("solved faces have a cell on each side");
+            let (eps_lo, eps_hi) = (eps[grid.cell(cell_lo)], eps[grid.cell(cell_hi)]);
+            let eps_f = 0.5 * (eps_lo + eps_hi);
+            let mut ap = 0.0;
+            let mut b = 0.0;
+            let mut net_out = 0.0;
+            let mut slot = 0;
+            let mut add =
+                |sys: &mut StencilSystem, neighbour: Result<usize, f64>, a_nb: f64, ap: &mut f64, b: &mut f64| {
+                    *ap += a_nb;
+                    match neighbour {
+                        Ok(face) => {
+                            let q = self.unknown[c][face];
+                            if q == NONE {
+                                *b += a_nb * u[c][face];
+                            } else {
+                                sys.nb[row][slot] = q;
+                                sys.anb[row][slot] = a_nb;
+                                slot += 1;
+                            }
+                        }
+                        Err(value) => *b += a_nb * value,
+                    }
+                };
+            // Along c: the control volume's faces are the centres of cell_lo and cell_hi.
+            let area_c = grid.face_area_m2(c);
+            let face_at = |along: isize| -> usize {
+                let n = grid.n[c] as isize;
+                let mut j = idx;
+                j[c] = if grid.periodic(c) {
+                    along.rem_euclid(n) as usize
+                } else {
+                    along as usize
+                };
+                grid.face(c, j)
+            };
+            let f_east = face_at(i_c as isize + 1);
+            let f_west = face_at(i_c as isize - 1);
+            let flux_e = rho * eps_hi * 0.5 * (u[c][f] + u[c][f_east]) * area_c;
+            let flux_w = rho * eps_lo * 0.5 * (u[c][f_west] + u[c][f]) * area_c;
+            let diff_e = mu * eps_hi * area_c / grid.h_m[c];
+            let diff_w = mu * eps_lo * area_c / grid.h_m[c];
+            add(&mut sys, Ok(f_east), coefficient(-flux_e, diff_e), &mut ap, &mut b);
+            add(&mut sys, Ok(f_west), coefficient(flux_w, diff_w), &mut ap, &mut b);
+            net_out += flux_e - flux_w;
+            // Across c: faces between this row of c-faces and the next along d.
+            for dax in (0..grid.axes()).filter(|&x| x != c) {
+                let area_d = grid.face_area_m2(dax);
+                for high in [false, true] {
+                    let delta = if high { 1 } else { -1 };
+                    // The d-face between cell_lo/cell_hi and their neighbours along d.
+                    let d_face_index = |cell: [usize; 3]| -> usize {
+                        let mut j = cell;
+                        j[dax] = cell[dax] + usize::from(high);
+                        grid.face(dax, j)
+                    };
+                    let v_flux = 0.5 * (u[dax][d_face_index(cell_lo)] + u[dax][d_face_index(cell_hi)]);
+                    let neighbour_hi = step_cell(grid, cell_hi, dax, delta);
+                    let neighbour_lo = step_cell(grid, cell_lo, dax, delta);
+                    let sign = if high { 1.0 } else { -1.0 };
+                    match (neighbour_lo, neighbour_hi) {
+                        (Some(nl), Some(nh)) => {
+                            let eps_corner = 0.25 * (eps_lo + eps_hi + eps[grid.cell(nl)] + eps[grid.cell(nh)]);
+                            let flux = rho * eps_corner * v_flux * area_d;
+                            let diff = mu * eps_corner * area_d / grid.h_m[dax];
+                            let mut j = idx;
+                            j[dax] = nh[dax];
+                            add(
+                                &mut sys,
+                                Ok(grid.face(c, j)),
+                                coefficient(-sign * flux, diff),
+                                &mut ap,
+                                &mut b,
+                            );
+                            net_out += sign * flux;
+                        }
+                        _ => {
+                            // A wall or inlet along d: the ghost value is the side's tangential velocity, half a
+                            // cell away.
+                            let boundary = grid.boundary[side(dax, high)];
+                            let flux = rho * eps_f * v_flux * area_d;
+                            let diff = mu * eps_f * area_d / (0.5 * grid.h_m[dax]);
+                            add(
+                                &mut sys,
+                                Err(side_velocity(boundary)[c]),
+                                coefficient(-sign * flux, diff),
+                                &mut ap,
+                                &mut b,
+                            );
+                            net_out += sign * flux;
+                        }
+                    }
+                }
+            }
+            let a_p0 = rho * eps_f * volume / dt_s;
+            ap += a_p0 + net_out;
+            b += a_p0 * old[f];
+            b += eps_f * (p[grid.cell(cell_lo)] - p[grid.cell(cell_hi)]) * area_c;
+            b += (rho * eps_f * cfg.gravity_m_per_s2[c]) * volume + source[f] * volume;
+            // Under-relaxation (Patankar's implicit form).
+            let alpha = cfg.relax_velocity;
+            ap /= alpha;
+            b += (1.0 - alpha) * ap * u[c][f];
+            sys.ap[row] = ap;
+            sys.b[row] = b;
+            d[f] = eps_f * area_c / ap;
+        }
+        self.d[c] = d;
+        sys
+    }
+
+    /// Net mass outflow of each cell (kg/s) plus the accumulation term: the pressure-correction right-hand side
+    /// with its sign flipped.
+    fn assemble_pressure_correction(&self, dt_s: f64, old_porosity: &[f64]) -> (StencilSystem, f64) {
+        let grid = &self.config.grid;
+        let rho = self.config.density_kg_per_m3;
+        let u = &self.state.velocity_m_per_s;
+        let eps = &self.state.porosity;
+        let mut sys = StencilSystem::new(grid.cells());
+        let mut imbalance = 0.0;
+        let mut throughput = 0.0;
+        for idx in all_indices(grid.n) {
+            let pcell = grid.cell(idx);
+            let mut net_out = 0.0;
+            let mut slot = 0;
+            for a in 0..grid.axes() {
+                let area = grid.face_area_m2(a);
+                for high in [false, true] {
+                    let mut fi = idx;
+                    fi[a] += usize::from(high);
+                    let face = grid.face(a, fi);
+                    let eps_f = self.porosity_at_face(a, fi);
+                    let flux = rho * eps_f * u[a][face] * area;
+                    net_out += if high { flux } else { -flux };
+                    throughput += 0.5 * flux.abs();
+                    // The solved copy of this face (the first face stands for the last on a periodic axis).
+                    let solved_face = if grid.periodic(a) && fi[a] == grid.n[a] {
+                        let mut first = fi;
+                        first[a] = 0;
+                        grid.face(a, first)
+                    } else {
+                        face
+                    };
+                    if self.unknown[a][solved_face] != NONE
+                        && let Some(nb) = step_cell(grid, idx, a, if high { 1 } else { -1 })
+                    {
+                        let coeff = rho * eps_f * area * self.d[a][solved_face];
+                        sys.ap[pcell] += coeff;
+                        sys.nb[pcell][slot] = grid.cell(nb) as u32;
+                        sys.anb[pcell][slot] = coeff;
+                        slot += 1;
+                    }
+                }
+            }
+            let accumulation = rho * grid.cell_volume_m3() * (eps[pcell] - old_porosity[pcell]) / dt_s;
+            sys.b[pcell] = -(net_out + accumulation);
+            imbalance += (net_out + accumulation).abs();
+        }
+        (sys, imbalance / throughput.max(f64::MIN_POSITIVE))
+    }
+
+    /// Advances the gas by `dt_s` with momentum source `source[a][face]` (N/m³) on each component's faces.
+    /// `old_porosity` is ε at the start of the step (the current ε is `state.porosity`).
+    pub fn step(&mut self, dt_s: f64, source: &[Vec<f64>; 3], old_porosity: &[f64]) -> StepReport {
+        let axes = self.config.grid.axes();
+        let old: [Vec<f64>; 3] = self.state.velocity_m_per_s.clone();
+        let mut report = StepReport {
+            outer_iterations: 0,
+            mass_imbalance: f64::INFINITY,
+            velocity_change: f64::INFINITY,
+            converged: false,
+            momentum: SolveReport {
+                iterations: 0,
+                relative_residual: 0.0,
+                converged: true,
+            },
+            pressure: SolveReport {
+                iterations: 0,
+                relative_residual: 0.0,
+                converged: true,
+            },
+        };
+        for outer in 0..self.config.max_outer_iterations {
+            let before = self.state.velocity_m_per_s.clone();
+            for c in 0..axes {
+                let sys = self.assemble_momentum(c, dt_s, &old[c], &source[c]);
+                let mut x: Vec<f64> = self.face_of[c]
+                    .iter()
+                    .map(|&f| self.state.velocity_m_per_s[c][f])
+                    .collect();
+                let r = bicgstab(
+                    &sys,
+                    &mut x,
+                    self.config.linear_tolerance,
+                    self.config.max_linear_iterations,
+                );
+                report.momentum.iterations += r.iterations;
+                report.momentum.relative_residual = report.momentum.relative_residual.max(r.relative_residual);
+                report.momentum.converged &= r.converged;
+                for (q, &f) in self.face_of[c].iter().enumerate() {
+                    self.state.velocity_m_per_s[c][f] = x[q];
+                }
+            }
+            self.apply_boundary_velocities();
+            let (psys, imbalance) = self.assemble_pressure_correction(dt_s, old_porosity);
+            report.outer_iterations = outer + 1;
+            report.mass_imbalance = imbalance;
+            let (mut change, mut scale) = (0.0f64, 0.0f64);
+            for (now, was) in self.state.velocity_m_per_s.iter().zip(&before).take(axes) {
+                for (a, b) in now.iter().zip(was) {
+                    change = change.max((a - b).abs());
+                    scale = scale.max(a.abs());
+                }
+            }
+            report.velocity_change = change / scale.max(f64::MIN_POSITIVE);
+            if imbalance < self.config.mass_tolerance
+                && report.velocity_change < self.config.velocity_tolerance
+                && outer > 0
+            {
+                report.converged = true;
+                break;
+            }
+            let mut pc = vec![0.0; psys.len()];
+            let r = conjugate_gradient(
+                &psys,
+                &mut pc,
+                self.config.linear_tolerance,
+                self.config.max_linear_iterations,
+                true,
+            );
+            report.pressure.iterations += r.iterations;
+            report.pressure.relative_residual = report.pressure.relative_residual.max(r.relative_residual);
+            report.pressure.converged &= r.converged;
+            let grid = &self.config.grid;
+            for (pv, corr) in self.state.pressure_pa.iter_mut().zip(&pc) {
+                *pv += self.config.relax_pressure * corr;
+            }
+            for c in 0..axes {
+                for &f in &self.face_of[c] {
+                    let idx = face_index(grid, c, f);
+                    let lo = step_cell(grid, idx, c, -1).expect("solved faces have two cells");
+                    self.state.velocity_m_per_s[c][f] += self.d[c][f] * (pc[grid.cell(lo)] - pc[grid.cell(idx)]);
+                }
+            }
+            self.apply_boundary_velocities();
+        }
+        self.state.time_s += dt_s;
+        report
+    }
+}
+
+/// The (i, j, k) of face `f` of the component along `axis`.
+fn face_index(grid: &Grid, axis: usize, f: usize) -> [usize; 3] {
+    let d = grid.face_dims(axis);
+    [f % d[0], (f / d[0]) % d[1], f / (d[0] * d[1])]
+}

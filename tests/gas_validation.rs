@@ -1,0 +1,184 @@
+//! VALIDATION C1 (plane Poiseuille flow) and C2 (lid-driven cavity against Ghia, Ghia & Shin 1982) for the gas
+//! solver.
+
+use granflow::engine::gas::{Boundary, Convection, GasConfig, GasSolver, Grid};
+
+fn config(grid: Grid, density: f64, viscosity: f64, convection: Convection) -> GasConfig {
+    GasConfig {
+        grid,
+        density_kg_per_m3: density,
+        viscosity_pa_s: viscosity,
+        gravity_m_per_s2: [0.0; 3],
+        convection,
+        relax_velocity: 0.7,
+        relax_pressure: 0.3,
+        max_outer_iterations: 200,
+        mass_tolerance: 1e-9,
+        velocity_tolerance: 1e-7,
+        linear_tolerance: 1e-10,
+        max_linear_iterations: 2000,
+    }
+}
+
+const WALL: Boundary = Boundary::Wall {
+    velocity_m_per_s: [0.0; 3],
+};
+
+/// C1: a channel of height H between no-slip walls, periodic along the flow, driven by a uniform pressure gradient
+/// G (a body force): u(y) = G y (H − y) / (2μ). Target: max error < 1 % of the centreline velocity.
+#[test]
+fn c1_plane_poiseuille_profile() {
+    let (h, mu, rho, g) = (0.01, 1.8e-5, 1.2, 0.5);
+    let ny = 20;
+    let grid = Grid {
+        n: [8, ny, 1],
+        h_m: [0.002, h / ny as f64, 0.002],
+        origin_m: [0.0; 3],
+        boundary: [Boundary::Periodic, Boundary::Periodic, WALL, WALL, WALL, WALL],
+    };
+    let mut solver = GasSolver::new(config(grid.clone(), rho, mu, Convection::Hybrid)).unwrap();
+    let source = [vec![g; grid.faces(0)], vec![0.0; grid.faces(1)], vec![]];
+    let eps = solver.state.porosity.clone();
+    // Implicit steps of several viscous times H²/ν each, to the steady state.
+    for _ in 0..40 {
+        solver.step(20.0, &source, &eps);
+    }
+    let u_max = g * h * h / (8.0 * mu);
+    let mut worst: f64 = 0.0;
+    for j in 0..ny {
+        let y = (j as f64 + 0.5) * h / ny as f64;
+        let exact = g * y * (h - y) / (2.0 * mu);
+        for i in 0..grid.n[0] {
+            let u = solver.state.velocity_m_per_s[0][grid.face(0, [i, j, 0])];
+            worst = worst.max((u - exact).abs() / u_max);
+        }
+    }
+    eprintln!("C1: max error {:.3} % of the centreline velocity", 100.0 * worst);
+    assert!(
+        worst < 0.01,
+        "max error {:.3} % of the centreline velocity",
+        100.0 * worst
+    );
+}
+
+/// Ghia, Ghia & Shin (1982), Table I, Re = 100: u along the vertical centreline (y, u).
+const GHIA_U: [(f64, f64); 17] = [
+    (1.0000, 1.00000),
+    (0.9766, 0.84123),
+    (0.9688, 0.78871),
+    (0.9609, 0.73722),
+    (0.9531, 0.68717),
+    (0.8516, 0.23151),
+    (0.7344, 0.00332),
+    (0.6172, -0.13641),
+    (0.5000, -0.20581),
+    (0.4531, -0.21090),
+    (0.2813, -0.15662),
+    (0.1719, -0.10150),
+    (0.1016, -0.06434),
+    (0.0703, -0.04775),
+    (0.0625, -0.04192),
+    (0.0547, -0.03717),
+    (0.0000, 0.00000),
+];
+
+/// Table II, Re = 100: v along the horizontal centreline (x, v).
+const GHIA_V: [(f64, f64); 17] = [
+    (1.0000, 0.00000),
+    (0.9688, -0.05906),
+    (0.9609, -0.07391),
+    (0.9531, -0.08864),
+    (0.9453, -0.10313),
+    (0.9063, -0.16914),
+    (0.8594, -0.22445),
+    (0.8047, -0.24533),
+    (0.5000, 0.05454),
+    (0.2344, 0.17527),
+    (0.2266, 0.17507),
+    (0.1563, 0.16077),
+    (0.0938, 0.12317),
+    (0.0781, 0.10890),
+    (0.0703, 0.10091),
+    (0.0625, 0.09233),
+    (0.0000, 0.00000),
+];
+
+/// Linear interpolation in a table of (position, value) sorted by position, with end values (wall values) added.
+fn interpolate(points: &[(f64, f64)], x: f64) -> f64 {
+    for w in points.windows(2) {
+        let ((x0, y0), (x1, y1)) = (w[0], w[1]);
+        if x >= x0 && x <= x1 {
+            return y0 + (y1 - y0) * (x - x0) / (x1 - x0);
+        }
+    }
+    panic!("{x} outside the table");
+}
+
+/// C2: a unit cavity, lid velocity 1, Re = 100, hybrid convection on 64 × 64 cells, to steady state. Target: both
+/// centreline profiles within 2 % of the lid velocity of Ghia's values.
+#[test]
+fn c2_lid_driven_cavity_matches_ghia_at_re_100() {
+    let n = 64;
+    let lid = Boundary::Wall {
+        velocity_m_per_s: [1.0, 0.0, 0.0],
+    };
+    let grid = Grid {
+        n: [n, n, 1],
+        h_m: [1.0 / n as f64, 1.0 / n as f64, 1.0 / n as f64],
+        origin_m: [0.0; 3],
+        boundary: [WALL, WALL, WALL, lid, WALL, WALL],
+    };
+    // To the steady state by time marching: a few outer iterations per step suffice.
+    let mut cfg = config(grid.clone(), 1.0, 0.01, Convection::Hybrid);
+    cfg.max_outer_iterations = 8;
+    let mut solver = GasSolver::new(cfg).unwrap();
+    let source = [vec![0.0; grid.faces(0)], vec![0.0; grid.faces(1)], vec![]];
+    let eps = solver.state.porosity.clone();
+    let mut previous = solver.state.velocity_m_per_s.clone();
+    let mut steps = 0;
+    loop {
+        let report = solver.step(0.5, &source, &eps);
+        steps += 1;
+        let change = solver.state.velocity_m_per_s[0]
+            .iter()
+            .zip(&previous[0])
+            .map(|(a, b)| (a - b).abs())
+            .fold(0.0, f64::max);
+        previous = solver.state.velocity_m_per_s.clone();
+        if change < 1e-7 || steps >= 2000 {
+            assert!(report.mass_imbalance < 1e-5, "{report:?}");
+            break;
+        }
+    }
+    // u on the x-faces at x = 0.5 (face column n/2), at cell-centre heights; walls: 0 below, 1 above.
+    let mut u_line = vec![(0.0, 0.0)];
+    for j in 0..n {
+        u_line.push((
+            (j as f64 + 0.5) / n as f64,
+            solver.state.velocity_m_per_s[0][grid.face(0, [n / 2, j, 0])],
+        ));
+    }
+    u_line.push((1.0, 1.0));
+    let mut v_line = vec![(0.0, 0.0)];
+    for i in 0..n {
+        v_line.push((
+            (i as f64 + 0.5) / n as f64,
+            solver.state.velocity_m_per_s[1][grid.face(1, [i, n / 2, 0])],
+        ));
+    }
+    v_line.push((1.0, 0.0));
+    let mut worst: f64 = 0.0;
+    let mut lines = String::new();
+    for &(y, u) in &GHIA_U {
+        let ours = interpolate(&u_line, y);
+        worst = worst.max((ours - u).abs());
+        lines += &format!("u(y={y}) ours {ours:.5} ghia {u:.5}\n");
+    }
+    for &(x, v) in &GHIA_V {
+        let ours = interpolate(&v_line, x);
+        worst = worst.max((ours - v).abs());
+        lines += &format!("v(x={x}) ours {ours:.5} ghia {v:.5}\n");
+    }
+    eprintln!("{lines}max |error| {worst:.4} of the lid velocity after {steps} steps");
+    assert!(worst < 0.02, "{lines}max error {worst:.4} of the lid velocity");
+}
