@@ -41,7 +41,7 @@ fn c1_plane_poiseuille_profile() {
     let eps = solver.state.porosity.clone();
     // Implicit steps of several viscous times H²/ν each, to the steady state.
     for _ in 0..40 {
-        solver.step(20.0, &source, &eps);
+        solver.step(20.0, &source, &Default::default(), &eps);
     }
     let u_max = g * h * h / (8.0 * mu);
     let mut worst: f64 = 0.0;
@@ -137,7 +137,7 @@ fn c2_lid_driven_cavity_matches_ghia_at_re_100() {
     let mut previous = solver.state.velocity_m_per_s.clone();
     let mut steps = 0;
     loop {
-        let report = solver.step(0.5, &source, &eps);
+        let report = solver.step(0.5, &source, &Default::default(), &eps);
         steps += 1;
         let change = solver.state.velocity_m_per_s[0]
             .iter()
@@ -181,4 +181,73 @@ fn c2_lid_driven_cavity_matches_ghia_at_re_100() {
     }
     eprintln!("{lines}max |error| {worst:.4} of the lid velocity after {steps} steps");
     assert!(worst < 0.02, "{lines}max error {worst:.4} of the lid velocity");
+}
+
+/// C3: gas through a fixed bed of 3 mm spheres at ε = 0.4 between an inlet plenum and an outlet (ε = 1 above and
+/// below), with the drag of particles at rest as an implicit sink. The pressure gradient inside the bed against the
+/// Ergun equation over particle Reynolds numbers 1–500: within 10 % (Di Felice, the default law; Ergun/Wen-Yu, whose
+/// dense branch is Ergun's equation, within 1 %).
+#[test]
+fn c3_fixed_bed_pressure_gradient_follows_ergun() {
+    use granflow::engine::gas::exchange::{cell_beta, cell_velocity, to_faces};
+    use granflow::engine::models::drag::DragLaw;
+    let (d, eps_bed, rho, mu) = (0.003, 0.4, 1.2, 1.8e-5);
+    let (nx, ny, h) = (4, 40, 0.005);
+    for (law, tolerance) in [(DragLaw::ErgunWenYu, 0.01), (DragLaw::DiFelice, 0.10)] {
+        for re_p in [1.0, 10.0, 100.0, 500.0] {
+            let u_sup = re_p * mu / (rho * d);
+            let grid = Grid {
+                n: [nx, ny, 1],
+                h_m: [h, h, h],
+                origin_m: [0.0; 3],
+                boundary: [
+                    Boundary::Periodic,
+                    Boundary::Periodic,
+                    Boundary::Inlet {
+                        velocity_m_per_s: [0.0, u_sup, 0.0],
+                    },
+                    Boundary::Outlet,
+                    WALL,
+                    WALL,
+                ],
+            };
+            let mut cfg = config(grid.clone(), rho, mu, Convection::Hybrid);
+            cfg.max_outer_iterations = 30;
+            let mut solver = GasSolver::new(cfg).unwrap();
+            let in_bed = |j: usize| (10..30).contains(&j);
+            for j in 0..ny {
+                for i in 0..nx {
+                    solver.state.porosity[grid.cell([i, j, 0])] = if in_bed(j) { eps_bed } else { 1.0 };
+                }
+            }
+            let eps = solver.state.porosity.clone();
+            let source = [vec![], vec![], vec![]];
+            for _ in 0..60 {
+                let u_cells = cell_velocity(&grid, &solver.state.velocity_m_per_s);
+                let beta: Vec<f64> = (0..grid.cells())
+                    .map(|c| {
+                        let speed = (u_cells[c][0].powi(2) + u_cells[c][1].powi(2)).sqrt();
+                        cell_beta(law, eps[c], speed, d, rho, mu)
+                    })
+                    .collect();
+                let sink = [to_faces(&grid, &beta, 0), to_faces(&grid, &beta, 1), vec![]];
+                solver.step(1.0, &source, &sink, &eps);
+            }
+            // −dp/dy between rows 15 and 25 (well inside the bed).
+            let p = |j: usize| solver.state.pressure_pa[grid.cell([0, j, 0])];
+            let gradient = (p(15) - p(25)) / (10.0 * h);
+            let ergun = 150.0 * mu * (1.0 - eps_bed).powi(2) * u_sup / (eps_bed.powi(3) * d * d)
+                + 1.75 * rho * (1.0 - eps_bed) * u_sup * u_sup / (eps_bed.powi(3) * d);
+            let error = gradient / ergun - 1.0;
+            eprintln!(
+                "C3 {law:?} Re_p = {re_p}: −dp/dy = {gradient:.4e} Pa/m, Ergun {ergun:.4e}, {:+.2} %",
+                100.0 * error
+            );
+            assert!(
+                error.abs() < tolerance,
+                "{law:?} at Re_p {re_p}: {:+.2} %",
+                100.0 * error
+            );
+        }
+    }
 }

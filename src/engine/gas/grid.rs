@@ -13,6 +13,9 @@ pub enum Boundary {
     Periodic,
     /// Gas enters (or leaves) with this velocity; tangential components act as a moving wall.
     Inlet { velocity_m_per_s: [f64; 3] },
+    /// Gas leaves with zero normal gradient of velocity; the pressure there is the reference (0). The outflow is
+    /// scaled so that the domain conserves mass (inflow minus the change of gas volume inside).
+    Outlet,
 }
 
 /// Index of a side: 2·axis for the low side, 2·axis + 1 for the high side.

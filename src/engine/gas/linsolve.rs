@@ -191,7 +191,6 @@ pub fn bicgstab(sys: &StencilSystem, x: &mut [f64], tolerance: f64, max_iteratio
             }
             r.copy_from_slice(&s);
             iterations += 1;
-            rel = norm(&r) / b_norm;
             break;
         }
         for i in 0..n {

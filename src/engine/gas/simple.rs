@@ -104,7 +104,7 @@ fn all_indices(dims: [usize; 3]) -> impl Iterator<Item = [usize; 3]> {
 fn side_velocity(b: Boundary) -> [f64; 3] {
     match b {
         Boundary::Wall { velocity_m_per_s } | Boundary::Inlet { velocity_m_per_s } => velocity_m_per_s,
-        Boundary::Periodic => [0.0; 3],
+        Boundary::Periodic | Boundary::Outlet => [0.0; 3],
     }
 }
 
@@ -170,9 +170,68 @@ impl GasSolver {
                     let b = grid.boundary[side(a, along == grid.n[a])];
                     self.state.velocity_m_per_s[a][f] = match b {
                         Boundary::Inlet { velocity_m_per_s } => velocity_m_per_s[a],
+                        Boundary::Outlet if grid.n[a] > 1 => {
+                            // Zero gradient: the next face inwards.
+                            let mut inner = idx;
+                            inner[a] = if along == 0 { 1 } else { grid.n[a] - 1 };
+                            self.state.velocity_m_per_s[a][grid.face(a, inner)]
+                        }
                         _ => 0.0,
                     };
                 }
+            }
+        }
+    }
+
+    /// Scales the outlet faces' velocities so that outflow = inflow through the other boundary faces minus the gas
+    /// accumulating inside (global continuity), as a zero-gradient outlet needs.
+    fn balance_outlets(&mut self, dt_s: f64, old_porosity: &[f64]) {
+        let grid = &self.config.grid;
+        let rho = self.config.density_kg_per_m3;
+        let (mut inflow, mut outflow) = (0.0, 0.0);
+        let mut outlet_faces = Vec::new();
+        for a in 0..grid.axes() {
+            if grid.periodic(a) {
+                continue;
+            }
+            let area = grid.face_area_m2(a);
+            for idx in all_indices(grid.face_dims(a)) {
+                let along = idx[a];
+                if along != 0 && along != grid.n[a] {
+                    continue;
+                }
+                let f = grid.face(a, idx);
+                let inward = if along == 0 { 1.0 } else { -1.0 };
+                let flux = rho * self.porosity_at_face(a, idx) * self.state.velocity_m_per_s[a][f] * area;
+                if matches!(grid.boundary[side(a, along != 0)], Boundary::Outlet) {
+                    outflow -= inward * flux;
+                    outlet_faces.push((a, f, inward));
+                } else {
+                    inflow += inward * flux;
+                }
+            }
+        }
+        if outlet_faces.is_empty() {
+            return;
+        }
+        let accumulation: f64 = self
+            .state
+            .porosity
+            .iter()
+            .zip(old_porosity)
+            .map(|(e, e0)| rho * grid.cell_volume_m3() * (e - e0) / dt_s)
+            .sum();
+        let needed = inflow - accumulation;
+        if outflow.abs() > 1e-300 {
+            let scale = needed / outflow;
+            for &(a, f, _) in &outlet_faces {
+                self.state.velocity_m_per_s[a][f] *= scale;
+            }
+        } else {
+            // No outflow yet: spread the needed outflow evenly over the outlet faces.
+            let area_total: f64 = outlet_faces.iter().map(|&(a, _, _)| rho * grid.face_area_m2(a)).sum();
+            for &(a, f, inward) in &outlet_faces {
+                self.state.velocity_m_per_s[a][f] = -inward * needed / area_total;
             }
         }
     }
@@ -200,7 +259,7 @@ impl GasSolver {
     }
 
     /// Assembles the momentum system of component `c` and stores the pressure-correction coefficients.
-    fn assemble_momentum(&mut self, c: usize, dt_s: f64, old: &[f64], source: &[f64]) -> StencilSystem {
+    fn assemble_momentum(&mut self, c: usize, dt_s: f64, old: &[f64], source: &[f64], sink: &[f64]) -> StencilSystem {
         let cfg = &self.config;
         let grid = &cfg.grid;
         let (rho, mu) = (cfg.density_kg_per_m3, cfg.viscosity_pa_s);
@@ -317,10 +376,11 @@ impl GasSolver {
                 }
             }
             let a_p0 = rho * eps_f * volume / dt_s;
-            ap += a_p0 + net_out;
+            // The implicit part of the drag: −β u per unit volume (its +β v part is in `source`).
+            ap += a_p0 + net_out + sink.get(f).copied().unwrap_or(0.0) * volume;
             b += a_p0 * old[f];
             b += eps_f * (p[grid.cell(cell_lo)] - p[grid.cell(cell_hi)]) * area_c;
-            b += (rho * eps_f * cfg.gravity_m_per_s2[c]) * volume + source[f] * volume;
+            b += (rho * eps_f * cfg.gravity_m_per_s2[c]) * volume + source.get(f).copied().unwrap_or(0.0) * volume;
             // Under-relaxation (Patankar's implicit form).
             let alpha = cfg.relax_velocity;
             ap /= alpha;
@@ -383,9 +443,16 @@ impl GasSolver {
         (sys, imbalance / throughput.max(f64::MIN_POSITIVE))
     }
 
-    /// Advances the gas by `dt_s` with momentum source `source[a][face]` (N/m³) on each component's faces.
+    /// Advances the gas by `dt_s` with momentum source `source[a][face]` (N/m³) and implicit sink coefficient
+    /// `sink[a][face]` (the β of a drag −β u, N·s/m⁴; empty vectors mean none) on each component's faces.
     /// `old_porosity` is ε at the start of the step (the current ε is `state.porosity`).
-    pub fn step(&mut self, dt_s: f64, source: &[Vec<f64>; 3], old_porosity: &[f64]) -> StepReport {
+    pub fn step(
+        &mut self,
+        dt_s: f64,
+        source: &[Vec<f64>; 3],
+        sink: &[Vec<f64>; 3],
+        old_porosity: &[f64],
+    ) -> StepReport {
         let axes = self.config.grid.axes();
         let old: [Vec<f64>; 3] = self.state.velocity_m_per_s.clone();
         let mut report = StepReport {
@@ -407,7 +474,7 @@ impl GasSolver {
         for outer in 0..self.config.max_outer_iterations {
             let before = self.state.velocity_m_per_s.clone();
             for c in 0..axes {
-                let sys = self.assemble_momentum(c, dt_s, &old[c], &source[c]);
+                let sys = self.assemble_momentum(c, dt_s, &old[c], &source[c], &sink[c]);
                 let mut x: Vec<f64> = self.face_of[c]
                     .iter()
                     .map(|&f| self.state.velocity_m_per_s[c][f])
@@ -426,6 +493,7 @@ impl GasSolver {
                 }
             }
             self.apply_boundary_velocities();
+            self.balance_outlets(dt_s, old_porosity);
             let (psys, imbalance) = self.assemble_pressure_correction(dt_s, old_porosity);
             report.outer_iterations = outer + 1;
             report.mass_imbalance = imbalance;
@@ -467,9 +535,37 @@ impl GasSolver {
                 }
             }
             self.apply_boundary_velocities();
+            self.balance_outlets(dt_s, old_porosity);
+            self.fix_reference_pressure();
         }
         self.state.time_s += dt_s;
         report
+    }
+}
+
+impl GasSolver {
+    /// With an outlet, the pressure there is the reference: shifts p so that the mean pressure of the cells next to
+    /// the outlet faces is 0 (the zero-gradient extrapolation to the face).
+    fn fix_reference_pressure(&mut self) {
+        let grid = &self.config.grid;
+        let (mut sum, mut count) = (0.0, 0usize);
+        for a in 0..grid.axes() {
+            for high in [false, true] {
+                if !matches!(grid.boundary[side(a, high)], Boundary::Outlet) {
+                    continue;
+                }
+                for idx in all_indices(grid.n) {
+                    if idx[a] == if high { grid.n[a] - 1 } else { 0 } {
+                        sum += self.state.pressure_pa[grid.cell(idx)];
+                        count += 1;
+                    }
+                }
+            }
+        }
+        if count > 0 {
+            let shift = sum / count as f64;
+            self.state.pressure_pa.iter_mut().for_each(|p| *p -= shift);
+        }
     }
 }
 

@@ -2,6 +2,7 @@
 //! beside them. Cohesion, liquid bridges, drag, heat and mass transfer join here in later issues.
 
 pub mod contact_law;
+pub mod drag;
 pub mod history;
 pub mod normal;
 pub mod pair_table;
