@@ -251,3 +251,107 @@ fn c3_fixed_bed_pressure_gradient_follows_ergun() {
         }
     }
 }
+
+/// erfc(x) with fractional error below 1.2e-7 (Numerical Recipes' erfcc, a Chebyshev fit).
+fn erfc(x: f64) -> f64 {
+    let z = x.abs();
+    let t = 1.0 / (1.0 + 0.5 * z);
+    let r = t
+        * (-z * z - 1.26551223
+            + t * (1.00002368
+                + t * (0.37409196
+                    + t * (0.09678418
+                        + t * (-0.18628806
+                            + t * (0.27886807
+                                + t * (-1.13520398 + t * (1.48851587 + t * (-0.82215223 + t * 0.17087277)))))))))
+            .exp();
+    if x >= 0.0 { r } else { 2.0 - r }
+}
+
+fn line_grid(n: usize, length: f64) -> Grid {
+    Grid {
+        n: [n, 1, 1],
+        h_m: [length / n as f64, 0.01, 0.01],
+        origin_m: [0.0; 3],
+        boundary: [WALL, WALL, WALL, WALL, WALL, WALL],
+    }
+}
+
+/// C4a: 1-D transient diffusion from a wall held at φ = 1 into φ = 0: φ = erfc(x / (2√(Dt))). Target < 1 %.
+#[test]
+fn c4_diffusion_matches_erfc() {
+    use granflow::engine::gas::scalar::{ScalarBoundary, ScalarProblem, step_scalar};
+    let (n, length, diffusivity, rho) = (200, 1.0, 1e-3, 1.0);
+    let grid = line_grid(n, length);
+    let velocity = [vec![0.0; grid.faces(0)], vec![0.0; grid.faces(1)], vec![]];
+    let porosity = vec![1.0; n];
+    let problem = ScalarProblem {
+        grid: &grid,
+        convection: Convection::Hybrid,
+        density_kg_per_m3: rho,
+        diffusion_kg_per_m_s: rho * diffusivity,
+        velocity_m_per_s: &velocity,
+        porosity: &porosity,
+        boundary: [
+            ScalarBoundary::Fixed { value: 1.0 },
+            ScalarBoundary::ZeroFlux,
+            ScalarBoundary::ZeroFlux,
+            ScalarBoundary::ZeroFlux,
+            ScalarBoundary::ZeroFlux,
+            ScalarBoundary::ZeroFlux,
+        ],
+        source: &[],
+    };
+    let mut phi = vec![0.0; n];
+    let (dt, steps) = (0.005, 2000);
+    for _ in 0..steps {
+        assert!(step_scalar(&problem, &mut phi, dt, 1e-12).converged);
+    }
+    let t = dt * steps as f64;
+    let worst = (0..n)
+        .map(|i| {
+            let x = (i as f64 + 0.5) * length / n as f64;
+            (phi[i] - erfc(x / (2.0 * (diffusivity * t).sqrt()))).abs()
+        })
+        .fold(0.0, f64::max);
+    eprintln!("C4 diffusion: max error {:.4} % of the wall value", 100.0 * worst);
+    assert!(worst < 0.01, "max error {worst}");
+}
+
+/// C4b: steady 1-D advection-diffusion between φ = 0 (inflow side) and φ = 1 at Péclet number 10:
+/// φ = (exp(Pe x/L) − 1)/(exp(Pe) − 1). Target < 1 %.
+#[test]
+fn c4_advection_diffusion_matches_the_exponential_profile() {
+    use granflow::engine::gas::scalar::{ScalarBoundary, ScalarProblem, step_scalar};
+    let (n, length, diffusivity, rho, u) = (100, 1.0, 0.01, 1.0, 0.1);
+    let pe = u * length / diffusivity;
+    let grid = line_grid(n, length);
+    let velocity = [vec![u; grid.faces(0)], vec![0.0; grid.faces(1)], vec![]];
+    let porosity = vec![1.0; n];
+    let mut boundary = [ScalarBoundary::ZeroFlux; 6];
+    boundary[0] = ScalarBoundary::Fixed { value: 0.0 };
+    boundary[1] = ScalarBoundary::Fixed { value: 1.0 };
+    let problem = ScalarProblem {
+        grid: &grid,
+        convection: Convection::Hybrid,
+        density_kg_per_m3: rho,
+        diffusion_kg_per_m_s: rho * diffusivity,
+        velocity_m_per_s: &velocity,
+        porosity: &porosity,
+        boundary,
+        source: &[],
+    };
+    let mut phi = vec![0.0; n];
+    // Implicit steps far longer than the advection and diffusion times: one step reaches the steady state.
+    for _ in 0..3 {
+        assert!(step_scalar(&problem, &mut phi, 1e9, 1e-13).converged);
+    }
+    let worst = (0..n)
+        .map(|i| {
+            let x = (i as f64 + 0.5) * length / n as f64;
+            (phi[i] - ((pe * x / length).exp() - 1.0) / (pe.exp() - 1.0)).abs()
+        })
+        .fold(0.0, f64::max);
+    eprintln!("C4 advection-diffusion: max error {:.4} % of the range", 100.0 * worst);
+    assert!(worst < 0.01, "max error {worst}");
+}

@@ -4,6 +4,7 @@
 pub mod exchange;
 pub mod grid;
 pub mod linsolve;
+pub mod scalar;
 pub mod simple;
 
 pub use grid::{Boundary, Grid};
