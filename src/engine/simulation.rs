@@ -10,6 +10,7 @@ use std::time::{Duration, Instant};
 
 use super::contacts::AlignedHistory;
 use super::forces::{ForcePass, HalfKick, PairBuffers, RangePlan, compute_contact_forces};
+use super::gas::fluid_forces::FluidForces;
 use super::geometry::{Domain, Gravity, Wall};
 use super::integrate::{InverseInertia, find_lost, kick_drift};
 use super::models::{ContactLaw, PairTable};
@@ -73,6 +74,11 @@ pub struct Simulation {
     /// Threads of the per-step parallel force pass (same count as `pool`).
     team: Team,
     pub timers: StageTimers,
+    /// The gas's forces on the particles under a frozen gas field (a coupled simulation sets it). They are
+    /// evaluated once per step, at the new positions and half-step velocities, and loaded into the force arrays
+    /// before the contact pass adds onto them, so the pass itself is unchanged and any thread count gives the same
+    /// bits.
+    pub fluid: Option<FluidForces>,
 }
 
 impl Simulation {
@@ -100,6 +106,7 @@ impl Simulation {
             inverse,
             ranges: RangePlan::default(),
             pending_drift: None,
+            fluid: None,
             accumulators_zeroed: false,
             steps_since_rebalance: 0,
             pool: make_pool(threads),
@@ -130,6 +137,7 @@ impl Simulation {
             inverse,
             ranges: RangePlan::default(),
             pending_drift: None,
+            fluid: None,
             accumulators_zeroed: false,
             steps_since_rebalance: 0,
             pool: make_pool(threads),
@@ -268,6 +276,15 @@ impl Simulation {
         }
         self.steps_since_rebalance += 1;
         let t2 = Instant::now();
+        if let Some(fluid) = self.fluid.as_mut() {
+            if !self.accumulators_zeroed {
+                self.particles.force_n.iter_mut().for_each(|f| *f = Vec3::zeros());
+                self.particles.torque_n_m.iter_mut().for_each(|t| *t = Vec3::zeros());
+                self.accumulators_zeroed = true;
+            }
+            let p = &mut self.particles;
+            fluid.add_forces(&p.position_m, &p.velocity_m_per_s, &p.radius_m, &mut p.force_n);
+        }
         let kick = HalfKick {
             gravity: config.gravity.at(self.time_s),
             dt_s: dt,

@@ -1,0 +1,190 @@
+//! The gas's forces on particles under a frozen gas field, and their reaction on the gas.
+//!
+//! On particle i (seed 000 eq 2.67, seed 002 eq 28, viscous-stress term neglected as seed 002 does):
+//! f_i = −V_i ∇p + K_i (u(x_i) − v_i), with u interpolated to the particle and K_i from the drag law at the
+//! porosity of the particle's cell. The gas receives −K_i (u − v_i) (Newton's third law), spread to the faces with
+//! the same trilinear weights that interpolated u (faces on a non-periodic boundary pass their share to the next
+//! face inwards, so no momentum is lost). The pressure-gradient force is not returned to the gas: its momentum
+//! equation carries −ε∇p ("model A", seed 002 eq 32).
+
+use std::f64::consts::PI;
+
+use super::coupling::interpolate_component;
+use super::grid::Grid;
+use crate::engine::Vec3;
+use crate::engine::models::drag::{DragInput, DragLaw};
+
+/// A frozen gas field and the reaction accumulated since it was frozen.
+#[derive(Debug, Clone)]
+pub struct FluidForces {
+    pub grid: Grid,
+    pub drag: DragLaw,
+    pub gas_density_kg_per_m3: f64,
+    pub gas_viscosity_pa_s: f64,
+    /// Gas velocity on faces (copied from the gas solver).
+    pub velocity_m_per_s: [Vec<f64>; 3],
+    /// −∂p/∂x_a on the faces of component a, Pa/m.
+    pub minus_pressure_gradient_pa_per_m: [Vec<f64>; 3],
+    pub porosity: Vec<f64>,
+    /// Σ over DEM steps of the force on the gas per unit volume at each face, N/m³ (divide by `steps`).
+    pub reaction_n_per_m3: [Vec<f64>; 3],
+    pub steps: u32,
+}
+
+impl FluidForces {
+    pub fn new(grid: Grid, drag: DragLaw, gas_density_kg_per_m3: f64, gas_viscosity_pa_s: f64) -> Self {
+        let zeros = |g: &Grid| -> [Vec<f64>; 3] { std::array::from_fn(|a| vec![0.0; g.faces(a)]) };
+        FluidForces {
+            velocity_m_per_s: zeros(&grid),
+            minus_pressure_gradient_pa_per_m: zeros(&grid),
+            reaction_n_per_m3: zeros(&grid),
+            porosity: vec![1.0; grid.cells()],
+            steps: 0,
+            grid,
+            drag,
+            gas_density_kg_per_m3,
+            gas_viscosity_pa_s,
+        }
+    }
+
+    /// Freezes a new gas field: velocities, −∇p on faces from cell pressures, porosity; clears the reaction.
+    pub fn freeze(&mut self, velocity_m_per_s: &[Vec<f64>; 3], pressure_pa: &[f64], porosity: &[f64]) {
+        let grid = &self.grid;
+        for a in 0..grid.axes() {
+            self.velocity_m_per_s[a].copy_from_slice(&velocity_m_per_s[a]);
+            let dims = grid.face_dims(a);
+            let n = grid.n[a];
+            for k in 0..dims[2] {
+                for j in 0..dims[1] {
+                    for i in 0..dims[0] {
+                        let idx = [i, j, k];
+                        let along = idx[a];
+                        let cell = |at: usize| {
+                            let mut c = idx;
+                            c[a] = at;
+                            pressure_pa[grid.cell(c)]
+                        };
+                        let g = if grid.periodic(a) {
+                            (cell((along + n - 1) % n) - cell(along % n)) / grid.h_m[a]
+                        } else if n == 1 {
+                            0.0
+                        } else {
+                            // Boundary faces take the gradient of the next face inwards.
+                            let lo = along.clamp(1, n - 1);
+                            (cell(lo - 1) - cell(lo)) / grid.h_m[a]
+                        };
+                        self.minus_pressure_gradient_pa_per_m[a][grid.face(a, idx)] = g;
+                    }
+                }
+            }
+        }
+        self.porosity.copy_from_slice(porosity);
+        for r in &mut self.reaction_n_per_m3 {
+            r.iter_mut().for_each(|v| *v = 0.0);
+        }
+        self.steps = 0;
+    }
+
+    /// The trilinear weights of component `axis` at `x`, each face moved inwards off a non-periodic boundary.
+    fn weights(&self, axis: usize, x: &Vec3, out: &mut Vec<(usize, f64)>) {
+        out.clear();
+        let grid = &self.grid;
+        let dims = grid.face_dims(axis);
+        let mut lo = [0usize; 3];
+        let mut hi = [0usize; 3];
+        let mut w = [0.0f64; 3];
+        for a in 0..3 {
+            let offset = if a == axis { 0.0 } else { 0.5 };
+            let s = (x[a] - grid.origin_m[a]) / grid.h_m[a] - offset;
+            let base = s.floor();
+            let frac = s - base;
+            let base = base as isize;
+            if grid.periodic(a) {
+                let n = grid.n[a] as isize;
+                (lo[a], hi[a], w[a]) = (base.rem_euclid(n) as usize, (base + 1).rem_euclid(n) as usize, frac);
+            } else {
+                let max = dims[a] as isize - 1;
+                (lo[a], hi[a], w[a]) = if base < 0 {
+                    (0, 0, 0.0)
+                } else if base >= max {
+                    (max as usize, max as usize, 0.0)
+                } else {
+                    (base as usize, base as usize + 1, frac)
+                };
+            }
+        }
+        for corner in 0..8 {
+            let mut idx = [0usize; 3];
+            let mut weight = 1.0;
+            for a in 0..3 {
+                let upper = corner >> a & 1 == 1;
+                idx[a] = if upper { hi[a] } else { lo[a] };
+                weight *= if upper { w[a] } else { 1.0 - w[a] };
+            }
+            if weight == 0.0 {
+                continue;
+            }
+            if !grid.periodic(axis) && grid.n[axis] > 1 {
+                idx[axis] = idx[axis].clamp(1, grid.n[axis] - 1);
+            }
+            out.push((grid.face(axis, idx), weight));
+        }
+    }
+
+    /// Adds the gas's force on each particle to `force` and accumulates the reaction on the gas for one DEM step.
+    pub fn add_forces(
+        &mut self,
+        positions_m: &[Vec3],
+        velocities_m_per_s: &[Vec3],
+        radii_m: &[f64],
+        force: &mut [Vec3],
+    ) {
+        let grid = self.grid.clone();
+        let cell_volume = grid.cell_volume_m3();
+        let mut weights = Vec::with_capacity(8);
+        for i in 0..positions_m.len() {
+            let x = &positions_m[i];
+            let r = radii_m[i];
+            let volume = 4.0 / 3.0 * PI * r * r * r;
+            let cell: [usize; 3] = std::array::from_fn(|a| {
+                let c = ((x[a] - grid.origin_m[a]) / grid.h_m[a]).floor() as isize;
+                let n = grid.n[a] as isize;
+                if grid.periodic(a) {
+                    c.rem_euclid(n) as usize
+                } else {
+                    c.clamp(0, n - 1) as usize
+                }
+            });
+            let eps = self.porosity[grid.cell(cell)];
+            let mut u = Vec3::zeros();
+            let mut grad = Vec3::zeros();
+            for a in 0..grid.axes() {
+                u[a] = interpolate_component(&grid, &self.velocity_m_per_s[a], a, x);
+                grad[a] = interpolate_component(&grid, &self.minus_pressure_gradient_pa_per_m[a], a, x);
+            }
+            let slip = u - velocities_m_per_s[i];
+            let k = self.drag.coefficient_n_s_per_m(&DragInput {
+                porosity: eps,
+                slip_speed_m_per_s: slip.norm(),
+                diameter_m: 2.0 * r,
+                gas_density_kg_per_m3: self.gas_density_kg_per_m3,
+                gas_viscosity_pa_s: self.gas_viscosity_pa_s,
+            });
+            let drag = slip * k;
+            force[i] += drag + grad * volume;
+            for a in 0..grid.axes() {
+                self.weights(a, x, &mut weights);
+                for &(face, w) in &weights {
+                    self.reaction_n_per_m3[a][face] -= w * drag[a] / cell_volume;
+                }
+            }
+        }
+        self.steps += 1;
+    }
+
+    /// The mean reaction per unit volume over the DEM steps since the last freeze (the gas's momentum source).
+    pub fn mean_reaction(&self) -> [Vec<f64>; 3] {
+        let n = f64::from(self.steps.max(1));
+        std::array::from_fn(|a| self.reaction_n_per_m3[a].iter().map(|v| v / n).collect())
+    }
+}

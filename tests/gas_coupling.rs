@@ -1,0 +1,158 @@
+//! VALIDATION C5 (a single particle settling in gas reaches the terminal velocity its drag law implies) through the
+//! coupled gas–particle simulation, and Newton's third law between particles and gas.
+
+mod common;
+
+use common::{built, simulation};
+use granflow::engine::Vec3;
+use granflow::engine::gas::coupled::CoupledSimulation;
+use granflow::engine::gas::coupling::{PorosityMethod, gas_velocity_at};
+use granflow::engine::gas::{Boundary, Convection, GasConfig, Grid};
+use granflow::engine::models::drag::{DragInput, DragLaw};
+
+const RADIUS: f64 = 0.00025;
+const DENSITY: f64 = 1000.0;
+
+fn settling(threads: usize) -> CoupledSimulation {
+    // A periodic box (particles and gas): the particle falls for ever through quiescent air.
+    let yaml = format!(
+        r#"
+name: settling-sphere
+domain: {{ lo_m: [0.0, 0.0, 0.0], hi_m: [0.009, 0.009, 0.03], periodic: [true, true, true] }}
+gravity: {{ vector_m_per_s2: [0.0, 0.0, -9.81] }}
+species:
+  - {{ name: bead, radius_m: {RADIUS}, density_kg_per_m3: {DENSITY}, youngs_modulus_pa: 1.0e7, poisson_ratio: 0.3, friction_coefficient: 0.3 }}
+contact: {{ normal: {{ hertz: {{ restitution: 0.9 }} }}, tangential: mindlin }}
+fill:
+  - explicit: {{ species: bead, positions_m: [[0.0041, 0.0043, 0.02]] }}
+time: {{ dt_s: 1.0e-4, end_time_s: 2.0 }}
+"#
+    );
+    let b = built(&yaml);
+    let dem = simulation(&b, threads);
+    let grid = Grid {
+        n: [6, 6, 20],
+        h_m: [0.0015, 0.0015, 0.0015],
+        origin_m: [0.0; 3],
+        boundary: [Boundary::Periodic; 6],
+    };
+    let gas = GasConfig {
+        grid,
+        density_kg_per_m3: 1.2,
+        viscosity_pa_s: 1.8e-5,
+        // The weight of the gas is not simulated in a periodic box (it would accelerate for ever); the particle
+        // then feels no buoyancy, and its terminal slip satisfies K(w) w = m g.
+        gravity_m_per_s2: [0.0; 3],
+        convection: Convection::Hybrid,
+        relax_velocity: 0.8,
+        relax_pressure: 0.5,
+        max_outer_iterations: 20,
+        mass_tolerance: 1e-8,
+        velocity_tolerance: 1e-6,
+        linear_tolerance: 1e-10,
+        max_linear_iterations: 1000,
+    };
+    let mass = dem.particles.mass_kg[0];
+    let mut sim = CoupledSimulation::new(dem, gas, DragLaw::DiFelice, PorosityMethod::VolumeSplit, 0.3, 20).unwrap();
+    // The mean pressure gradient of a periodic suspension carries the particle's weight: without it the gas and
+    // particle together would accelerate downwards.
+    sim.gas_body_force_n_per_m3 = [0.0, 0.0, mass * 9.81 / (0.009 * 0.009 * 0.03)];
+    sim
+}
+
+#[test]
+fn c5_single_particle_reaches_the_terminal_velocity_of_its_drag_law() {
+    let mut sim = settling(1);
+    for _ in 0..750 {
+        sim.advance().unwrap();
+    }
+    let p = &sim.dem.particles;
+    let fluid = sim.dem.fluid.as_ref().unwrap();
+    let u = gas_velocity_at(&fluid.grid, &fluid.velocity_m_per_s, &p.position_m[0]);
+    let slip = (u - p.velocity_m_per_s[0]).z;
+    // The porosity the drag law saw: the particle's cell.
+    let x = p.position_m[0];
+    let cell = fluid.grid.cell(std::array::from_fn(|a| {
+        ((x[a] / fluid.grid.h_m[a]).floor() as usize) % fluid.grid.n[a]
+    }));
+    let eps = fluid.porosity[cell];
+    let mass = p.mass_kg[0];
+    let drag = |w: f64| {
+        DragLaw::DiFelice.coefficient_n_s_per_m(&DragInput {
+            porosity: eps,
+            slip_speed_m_per_s: w,
+            diameter_m: 2.0 * RADIUS,
+            gas_density_kg_per_m3: 1.2,
+            gas_viscosity_pa_s: 1.8e-5,
+        }) * w
+    };
+    // Bisection for K(w) w = m g.
+    let (mut lo, mut hi) = (0.0, 100.0);
+    for _ in 0..200 {
+        let mid = 0.5 * (lo + hi);
+        if drag(mid) < mass * 9.81 { lo = mid } else { hi = mid }
+    }
+    let terminal = 0.5 * (lo + hi);
+    let error = slip / terminal - 1.0;
+    eprintln!(
+        "C5: slip {slip:.5} m/s, terminal {terminal:.5} m/s ({:+.3} %), particle {:.4} m/s, gas at particle {:.4} m/s, ε {eps:.5}",
+        100.0 * error,
+        p.velocity_m_per_s[0].z,
+        u.z
+    );
+    assert!(error.abs() < 0.01, "{:+.3} %", 100.0 * error);
+}
+
+#[test]
+fn the_gas_receives_exactly_the_momentum_the_particle_loses_to_drag() {
+    let mut sim = settling(1);
+    for _ in 0..20 {
+        sim.advance().unwrap();
+    }
+    let mut fluid = sim.dem.fluid.clone().unwrap();
+    fluid
+        .reaction_n_per_m3
+        .iter_mut()
+        .for_each(|r| r.iter_mut().for_each(|v| *v = 0.0));
+    // Drag only: the pressure-gradient force is not returned to the gas (model A).
+    fluid
+        .minus_pressure_gradient_pa_per_m
+        .iter_mut()
+        .for_each(|r| r.iter_mut().for_each(|v| *v = 0.0));
+    let p = &sim.dem.particles;
+    let mut force = vec![Vec3::zeros(); 1];
+    fluid.add_forces(&p.position_m, &p.velocity_m_per_s, &p.radius_m, &mut force);
+    let volume = fluid.grid.cell_volume_m3();
+    for a in 0..3 {
+        let given: f64 = fluid.reaction_n_per_m3[a].iter().sum::<f64>() * volume;
+        assert!(
+            (given + force[0][a]).abs() <= 1e-12 * force[0].norm().max(1e-30),
+            "axis {a}: {given} vs {}",
+            force[0][a]
+        );
+    }
+}
+
+#[test]
+fn coupled_runs_are_bit_identical_on_one_and_two_threads() {
+    let mut one = settling(1);
+    let mut two = settling(2);
+    for _ in 0..30 {
+        one.advance().unwrap();
+        two.advance().unwrap();
+    }
+    let bits = |v: &Vec3| [v.x.to_bits(), v.y.to_bits(), v.z.to_bits()];
+    assert_eq!(
+        bits(&one.dem.particles.position_m[0]),
+        bits(&two.dem.particles.position_m[0])
+    );
+    assert_eq!(
+        bits(&one.dem.particles.velocity_m_per_s[0]),
+        bits(&two.dem.particles.velocity_m_per_s[0])
+    );
+    for a in 0..3 {
+        let ua: Vec<u64> = one.gas.state.velocity_m_per_s[a].iter().map(|v| v.to_bits()).collect();
+        let ub: Vec<u64> = two.gas.state.velocity_m_per_s[a].iter().map(|v| v.to_bits()).collect();
+        assert_eq!(ua, ub);
+    }
+}
