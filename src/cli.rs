@@ -91,6 +91,13 @@ pub enum Command {
         #[arg(long, value_enum, default_value = "csv")]
         format: Format,
     },
+    /// The validation report (Markdown) of a validation campaign: our numbers next to the source's, a verdict.
+    Report {
+        dir: PathBuf,
+        /// Write the report here (atomically) instead of printing it.
+        #[arg(long)]
+        out: Option<PathBuf>,
+    },
     /// Run one job of a campaign in its directory (started by the dispatcher).
     #[command(hide = true)]
     Worker {
@@ -288,6 +295,23 @@ pub fn run(cli: Cli) -> Result<i32> {
         }
         Command::Export { dir, format } => {
             print!("{}", inspect::export(&dir, format)?);
+            Ok(0)
+        }
+        Command::Report { dir, out } => {
+            let (text, pass) = crate::report::report(&dir)?;
+            match out {
+                Some(path) => {
+                    if let Some(parent) = path.parent().filter(|p| !p.as_os_str().is_empty()) {
+                        std::fs::create_dir_all(parent)
+                            .map_err(|e| crate::error::Error::io("create directory", parent, e))?;
+                    }
+                    crate::simulate::write_atomic(&path, text.as_bytes())?;
+                    eprintln!("{}: {}", path.display(), text.lines().last().unwrap_or_default());
+                }
+                None => print!("{text}"),
+            }
+            // A failed validation is a result, not an error: exit 0, the verdict says it.
+            let _ = pass;
             Ok(0)
         }
         Command::Worker {

@@ -15,6 +15,7 @@ pub mod error;
 pub mod inspect;
 mod models_doc;
 pub mod orchestrate;
+pub mod report;
 pub mod scenario;
 pub mod simulate;
 pub mod store;

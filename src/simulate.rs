@@ -66,12 +66,67 @@ pub fn checkpoint_meta(built: &BuiltScenario) -> CheckpointMeta {
     }
 }
 
-fn series_row(sim: &Simulation) -> String {
+/// Series columns of a run with a gas: the pressure drop from the inlet layer of cells to the far layer and to the
+/// probe height (`nan` without a probe), and how the last gas step converged.
+pub const GAS_SERIES_COLUMNS: &str =
+    ",column_pressure_drop_pa,probe_pressure_drop_pa,gas_outer_iterations,gas_linear_iterations,gas_mass_imbalance";
+
+/// The series header of a scenario (before any observer columns).
+pub fn series_header(built: &BuiltScenario) -> String {
+    if built.gas.is_some() {
+        format!("{SERIES_HEADER}{GAS_SERIES_COLUMNS}")
+    } else {
+        SERIES_HEADER.to_string()
+    }
+}
+
+fn gas_columns(sim: &Simulation, probe_height_m: Option<f64>) -> String {
+    let Some(gas) = sim.gas.as_ref() else {
+        return String::new();
+    };
+    let column = gas.column_pressure_drop_pa().unwrap_or(f64::NAN);
+    let probe = probe_height_m
+        .and_then(|h| gas.pressure_drop_to_pa(h))
+        .unwrap_or(f64::NAN);
+    format!(
+        ",{column:e},{probe:e},{},{},{:e}",
+        gas.last.outer_iterations, gas.last.linear_iterations, gas.last.mass_imbalance
+    )
+}
+
+/// Attaches the scenario's gas to a new or restored simulation (with the checkpointed gas state when restored).
+pub fn attach_gas(
+    built: &BuiltScenario,
+    sim: &mut Simulation,
+    restored: Option<&crate::engine::gas::coupled::GasSnapshot>,
+) -> Result<()> {
+    match (&built.gas, restored) {
+        (None, None) => Ok(()),
+        (None, Some(_)) => Err(Error::External(
+            "the checkpoint holds a gas state but the scenario has no gas".into(),
+        )),
+        (Some(setup), restored) => {
+            let p = &sim.particles;
+            let coupling = setup
+                .coupling(&p.position_m, &p.radius_m)
+                .map_err(|m| Error::External(format!("gas: {m}")))?;
+            sim.attach_gas(coupling);
+            match restored {
+                Some(snap) => sim.restore_gas(snap).map_err(Error::External),
+                // A checkpoint of a gas run always holds the gas; only a new run starts without one.
+                None => Ok(()),
+            }
+        }
+    }
+}
+
+fn series_row(sim: &Simulation, built: &BuiltScenario) -> String {
     let (top, mean) = sim.bed_height_m();
     let (pairs, walls) = sim.contact_counts();
     let n = sim.particles.len().max(1) as f64;
+    let gas = gas_columns(sim, built.gas.as_ref().and_then(|g| g.pressure_probe_height_m));
     format!(
-        "{},{:e},{:e},{:e},{:e},{:e},{},{},{:.6}",
+        "{},{:e},{:e},{:e},{:e},{:e},{},{},{:.6}{gas}",
         sim.step,
         sim.time_s,
         sim.particles.kinetic_energy_j(),
@@ -215,7 +270,7 @@ pub fn run_in_dir(built: &BuiltScenario, out: &Path, ctl: RunControl) -> Result<
         Err(e) => return Err(Error::io("read", &spec_path, e)),
     }
 
-    let header = format!("{SERIES_HEADER}{}", observer.extra_columns());
+    let header = format!("{}{}", series_header(built), observer.extra_columns());
     let series = CheckpointSeries::new(out, built.spec.output.keep_checkpoints);
     let series_path = out.join("series.csv");
     let (mut sim, resumed_from_step) = match series.latest_valid()? {
@@ -234,21 +289,29 @@ pub fn run_in_dir(built: &BuiltScenario, out: &Path, ctl: RunControl) -> Result<
             if !quiet {
                 eprintln!("resuming from {} (step {step})", loaded.path.display());
             }
-            (
-                Simulation::restore(built.config.clone(), loaded.state, threads)?,
-                Some(step),
-            )
+            let mut state = loaded.state;
+            let gas = state.gas.take();
+            if built.gas.is_some() && gas.is_none() {
+                return Err(Error::External(format!(
+                    "checkpoint {} holds no gas state but the scenario has a gas",
+                    loaded.path.display()
+                )));
+            }
+            let mut sim = Simulation::restore(built.config.clone(), state, threads)?;
+            attach_gas(built, &mut sim, gas.as_ref())?;
+            (sim, Some(step))
         }
         None => {
-            let sim = Simulation::new(
+            let mut sim = Simulation::new(
                 built.config.clone(),
                 built.particles.clone(),
                 built.dt_s,
                 built.rng,
                 threads,
             )?;
+            attach_gas(built, &mut sim, None)?;
             truncate_series(&series_path, &header, 0)?;
-            let row = format!("{}{}", series_row(&sim), observer.extra_row(&sim));
+            let row = format!("{}{}", series_row(&sim, built), observer.extra_row(&sim));
             let mut f = std::fs::OpenOptions::new()
                 .append(true)
                 .open(&series_path)
@@ -324,7 +387,7 @@ pub fn run_in_dir(built: &BuiltScenario, out: &Path, ctl: RunControl) -> Result<
             .min(stop_at);
         sim.run_steps(next - sim.step)?;
         if sim.step % built.spec.output.series_every_steps == 0 {
-            let row = format!("{}{}", series_row(&sim), observer.extra_row(&sim));
+            let row = format!("{}{}", series_row(&sim, built), observer.extra_row(&sim));
             writeln!(series_file, "{row}").map_err(|e| Error::io("write", &series_path, e))?;
         }
         if sim.step % built.spec.output.checkpoint_every_steps == 0 || sim.step == total_steps {

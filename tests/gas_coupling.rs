@@ -4,8 +4,9 @@
 mod common;
 
 use common::{built, simulation};
+use granflow::engine::Simulation;
 use granflow::engine::Vec3;
-use granflow::engine::gas::coupled::CoupledSimulation;
+use granflow::engine::gas::coupled::GasCoupling;
 use granflow::engine::gas::coupling::{PorosityMethod, gas_velocity_at};
 use granflow::engine::gas::{Boundary, Convection, GasConfig, Grid};
 use granflow::engine::models::drag::{DragInput, DragLaw};
@@ -13,7 +14,7 @@ use granflow::engine::models::drag::{DragInput, DragLaw};
 const RADIUS: f64 = 0.00025;
 const DENSITY: f64 = 1000.0;
 
-fn settling(threads: usize) -> CoupledSimulation {
+fn settling(threads: usize) -> Simulation {
     // A periodic box (particles and gas): the particle falls for ever through quiescent air.
     let yaml = format!(
         r#"
@@ -51,23 +52,36 @@ time: {{ dt_s: 1.0e-4, end_time_s: 2.0 }}
         velocity_tolerance: 1e-6,
         linear_tolerance: 1e-10,
         max_linear_iterations: 1000,
+        inlet_faces: Vec::new(),
     };
     let mass = dem.particles.mass_kg[0];
-    let mut sim = CoupledSimulation::new(dem, gas, DragLaw::DiFelice, PorosityMethod::VolumeSplit, 0.3, 20).unwrap();
+    let mut dem = dem;
+    let p = &dem.particles;
+    let mut coupling = GasCoupling::new(
+        gas,
+        DragLaw::DiFelice,
+        PorosityMethod::VolumeSplit,
+        0.3,
+        20,
+        &p.position_m,
+        &p.radius_m,
+    )
+    .unwrap();
     // The mean pressure gradient of a periodic suspension carries the particle's weight: without it the gas and
     // particle together would accelerate downwards.
-    sim.gas_body_force_n_per_m3 = [0.0, 0.0, mass * 9.81 / (0.009 * 0.009 * 0.03)];
-    sim
+    coupling.gas_body_force_n_per_m3 = [0.0, 0.0, mass * 9.81 / (0.009 * 0.009 * 0.03)];
+    dem.attach_gas(coupling);
+    dem
 }
 
 #[test]
 fn c5_single_particle_reaches_the_terminal_velocity_of_its_drag_law() {
     let mut sim = settling(1);
     for _ in 0..750 {
-        sim.advance().unwrap();
+        sim.run_steps(20).unwrap();
     }
-    let p = &sim.dem.particles;
-    let fluid = sim.dem.fluid.as_ref().unwrap();
+    let p = &sim.particles;
+    let fluid = &sim.gas.as_ref().unwrap().fluid;
     let u = gas_velocity_at(&fluid.grid, &fluid.velocity_m_per_s, &p.position_m[0]);
     let slip = (u - p.velocity_m_per_s[0]).z;
     // The porosity the drag law saw: the particle's cell.
@@ -107,9 +121,9 @@ fn c5_single_particle_reaches_the_terminal_velocity_of_its_drag_law() {
 fn the_gas_receives_exactly_the_momentum_the_particle_loses_to_drag() {
     let mut sim = settling(1);
     for _ in 0..20 {
-        sim.advance().unwrap();
+        sim.run_steps(20).unwrap();
     }
-    let mut fluid = sim.dem.fluid.clone().unwrap();
+    let mut fluid = sim.gas.as_ref().unwrap().fluid.clone();
     fluid
         .reaction_n_per_m3
         .iter_mut()
@@ -119,7 +133,7 @@ fn the_gas_receives_exactly_the_momentum_the_particle_loses_to_drag() {
         .minus_pressure_gradient_pa_per_m
         .iter_mut()
         .for_each(|r| r.iter_mut().for_each(|v| *v = 0.0));
-    let p = &sim.dem.particles;
+    let p = &sim.particles;
     let mut force = vec![Vec3::zeros(); 1];
     fluid.add_forces(&p.position_m, &p.velocity_m_per_s, &p.radius_m, &mut force);
     let volume = fluid.grid.cell_volume_m3();
@@ -138,21 +152,24 @@ fn coupled_runs_are_bit_identical_on_one_and_two_threads() {
     let mut one = settling(1);
     let mut two = settling(2);
     for _ in 0..30 {
-        one.advance().unwrap();
-        two.advance().unwrap();
+        one.run_steps(20).unwrap();
+        two.run_steps(20).unwrap();
     }
     let bits = |v: &Vec3| [v.x.to_bits(), v.y.to_bits(), v.z.to_bits()];
+    assert_eq!(bits(&one.particles.position_m[0]), bits(&two.particles.position_m[0]));
     assert_eq!(
-        bits(&one.dem.particles.position_m[0]),
-        bits(&two.dem.particles.position_m[0])
-    );
-    assert_eq!(
-        bits(&one.dem.particles.velocity_m_per_s[0]),
-        bits(&two.dem.particles.velocity_m_per_s[0])
+        bits(&one.particles.velocity_m_per_s[0]),
+        bits(&two.particles.velocity_m_per_s[0])
     );
     for a in 0..3 {
-        let ua: Vec<u64> = one.gas.state.velocity_m_per_s[a].iter().map(|v| v.to_bits()).collect();
-        let ub: Vec<u64> = two.gas.state.velocity_m_per_s[a].iter().map(|v| v.to_bits()).collect();
+        let ua: Vec<u64> = one.gas.as_ref().unwrap().solver.state.velocity_m_per_s[a]
+            .iter()
+            .map(|v| v.to_bits())
+            .collect();
+        let ub: Vec<u64> = two.gas.as_ref().unwrap().solver.state.velocity_m_per_s[a]
+            .iter()
+            .map(|v| v.to_bits())
+            .collect();
         assert_eq!(ua, ub);
     }
 }

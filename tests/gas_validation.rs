@@ -17,6 +17,7 @@ fn config(grid: Grid, density: f64, viscosity: f64, convection: Convection) -> G
         velocity_tolerance: 1e-7,
         linear_tolerance: 1e-10,
         max_linear_iterations: 2000,
+        inlet_faces: Vec::new(),
     }
 }
 

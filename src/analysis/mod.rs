@@ -11,6 +11,7 @@
 //! state directly, and nothing here is called while a simulation steps.
 
 pub mod fit;
+pub mod fluidization;
 pub mod granular;
 pub mod knn;
 pub mod mixing;

@@ -11,6 +11,8 @@ pub struct MetricInfo {
     pub description: &'static str,
     /// Needs `analysis.mixing_species` (a binary mixture).
     pub needs_mixing: bool,
+    /// Needs a gas in the scenario.
+    pub needs_gas: bool,
 }
 
 pub const METRICS: &[MetricInfo] = &[
@@ -19,60 +21,105 @@ pub const METRICS: &[MetricInfo] = &[
         unit: "J",
         description: "total (translational + rotational) kinetic energy at the end",
         needs_mixing: false,
+        needs_gas: false,
     },
     MetricInfo {
         name: "translational_kinetic_energy_j",
         unit: "J",
         description: "translational kinetic energy at the end",
         needs_mixing: false,
+        needs_gas: false,
     },
     MetricInfo {
         name: "bed_top_m",
         unit: "m",
         description: "highest particle centre along -gravity at the end (bed or column height)",
         needs_mixing: false,
+        needs_gas: false,
     },
     MetricInfo {
         name: "mean_height_m",
         unit: "m",
         description: "mean particle centre height along -gravity at the end",
         needs_mixing: false,
+        needs_gas: false,
     },
     MetricInfo {
         name: "coordination_number",
         unit: "1",
         description: "mean particle-particle contacts per particle at the end",
         needs_mixing: false,
+        needs_gas: false,
     },
     MetricInfo {
         name: "granular_temperature_m2_per_s2",
         unit: "m2/s2",
         description: "granular temperature at the end (seed 000 eq. 3.1)",
         needs_mixing: false,
+        needs_gas: false,
     },
     MetricInfo {
         name: "intensity_of_segregation",
         unit: "1",
         description: "IS at the end: std. dev. of the local volume fraction of the mixing species (seed 000 eqs 2.77-2.78)",
         needs_mixing: true,
+        needs_gas: false,
     },
     MetricInfo {
         name: "lacey_index",
         unit: "1",
         description: "Lacey mixing index at the end (seed 000 eq. 2.80)",
         needs_mixing: true,
+        needs_gas: false,
     },
     MetricInfo {
         name: "mixing_rate_constant_per_s",
         unit: "1/s",
         description: "k of an exponential fit to IS(t) (seed 000 §4.1.3)",
         needs_mixing: true,
+        needs_gas: false,
     },
     MetricInfo {
         name: "time_to_90pct_max_lacey_s",
         unit: "s",
         description: "first time the Lacey index reaches 90 % of its maximum (seed 000 Table 1)",
         needs_mixing: true,
+        needs_gas: false,
+    },
+    MetricInfo {
+        name: "mean_height_time_avg_m",
+        unit: "m",
+        description: "mean particle centre height along -gravity, averaged over the series from analysis.average_from_s (seed 002's mean particle height, 5-10 s)",
+        needs_mixing: false,
+        needs_gas: false,
+    },
+    MetricInfo {
+        name: "bed_weight_per_area_pa",
+        unit: "Pa",
+        description: "weight of the particles over the inlet area, W/A (seed 000 eq. 2.74): what the pressure drop of a fluidized bed carries",
+        needs_mixing: false,
+        needs_gas: true,
+    },
+    MetricInfo {
+        name: "pressure_drop_mean_pa",
+        unit: "Pa",
+        description: "time-averaged pressure drop from the inlet face to the top layer of gas cells, from analysis.average_from_s",
+        needs_mixing: false,
+        needs_gas: true,
+    },
+    MetricInfo {
+        name: "pressure_drop_std_pa",
+        unit: "Pa",
+        description: "standard deviation of that pressure drop over the same window (its jump marks u_mf, seed 000 §4.1.2)",
+        needs_mixing: false,
+        needs_gas: true,
+    },
+    MetricInfo {
+        name: "probe_pressure_drop_mean_pa",
+        unit: "Pa",
+        description: "time-averaged pressure drop from the inlet to gas.pressure_probe_height_m",
+        needs_mixing: false,
+        needs_gas: true,
     },
 ];
 
@@ -106,6 +153,17 @@ pub fn check(spec: &CampaignSpec) -> Result<(), (String, String)> {
             ));
         }
     }
+    if let Some(t) = spec.analysis.average_from_s
+        && !(t.is_finite() && t >= 0.0 && t < spec.base.time.end_time_s)
+    {
+        return Err((
+            "analysis.average_from_s".into(),
+            format!(
+                "expected 0 <= value < the end time ({} s), got {t}",
+                spec.base.time.end_time_s
+            ),
+        ));
+    }
     if spec.analysis.mixing_neighbours == 0 {
         return Err(("analysis.mixing_neighbours".into(), "expected at least 1".into()));
     }
@@ -125,6 +183,34 @@ pub fn check(spec: &CampaignSpec) -> Result<(), (String, String)> {
 
 /// Checks what depends on the resolved scenario (the mixing species must exist in it).
 pub fn check_job(job: &JobSpec) -> Result<(), (String, String)> {
+    if job.scenario.gas.is_none()
+        && let Some((k, name)) = job
+            .metrics
+            .iter()
+            .enumerate()
+            .find(|(_, m)| info(m).is_some_and(|i| i.needs_gas))
+    {
+        return Err((
+            format!("metrics[{k}]"),
+            format!("`{name}` needs a gas (a `gas:` section in the scenario)"),
+        ));
+    }
+    if let Some(p) = job
+        .metrics
+        .iter()
+        .position(|m| m == "probe_pressure_drop_mean_pa")
+        .filter(|_| {
+            job.scenario
+                .gas
+                .as_ref()
+                .is_some_and(|g| g.pressure_probe_height_m.is_none())
+        })
+    {
+        return Err((
+            format!("metrics[{p}]"),
+            "`probe_pressure_drop_mean_pa` needs gas.pressure_probe_height_m".into(),
+        ));
+    }
     if let Some(a) = &job.analysis.mixing_species
         && !job.scenario.species.iter().any(|s| &s.name == a)
     {

@@ -4,10 +4,12 @@
 //! (key paths), resolve each point against the base scenario and validate the result as a scenario would be, check
 //! the job count, duplicates and the metric names.
 
+pub mod derived;
 pub mod job;
 pub mod metrics;
 pub mod spec;
 pub mod sweep;
+pub mod validation;
 
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
@@ -108,8 +110,42 @@ pub fn from_yaml(yaml: &str, path: &Path) -> Result<Campaign, ConfigError> {
         ));
     }
 
+    if let Some(v) = &spec.validation {
+        v.check(&spec.metrics).map_err(|(key, m)| invalid(path, key, m))?;
+    }
     let points = sweep::expand(&spec.sweep, "sweep").map_err(|e| invalid(path, e.key, e.message))?;
     let names = sweep::axis_names(&spec.sweep);
+    for (k, d) in spec.derived.iter().enumerate() {
+        for m in d.required_metrics() {
+            if !spec.metrics.iter().any(|x| x == m) {
+                return Err(invalid(
+                    path,
+                    format!("derived[{k}]"),
+                    format!("needs the metric `{m}` in `metrics`"),
+                ));
+            }
+        }
+        let known: Vec<String> = sweep::param_keys(&spec.sweep, "sweep")
+            .into_iter()
+            .map(|(p, _)| {
+                names
+                    .iter()
+                    .find(|(q, _)| *q == p)
+                    .map_or(p.clone(), |(_, n)| n.clone())
+            })
+            .collect();
+        if !known.iter().any(|n| n == d.param()) {
+            return Err(invalid(
+                path,
+                format!("derived[{k}]"),
+                format!(
+                    "`{}` is not a sweep parameter; the sweep has {}",
+                    d.param(),
+                    known.join(", ")
+                ),
+            ));
+        }
+    }
     for (k, (p, n)) in names.iter().enumerate() {
         if names[..k].iter().any(|(p2, n2)| n2 == n && p2 != p) {
             return Err(invalid(

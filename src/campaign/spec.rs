@@ -34,6 +34,12 @@ pub struct CampaignSpec {
     /// Refuse to expand into more jobs than this.
     #[serde(default = "default_max_jobs")]
     pub max_jobs: usize,
+    /// Campaign-level metrics computed from several jobs (e.g. u_mf from a velocity sweep).
+    #[serde(default)]
+    pub derived: Vec<super::derived::DerivedSpec>,
+    /// A validation campaign: the case it reproduces and the checks `granflow report` evaluates.
+    #[serde(default)]
+    pub validation: Option<super::validation::ValidationSpec>,
 }
 
 fn default_metrics() -> Vec<String> {
@@ -98,6 +104,9 @@ pub struct AnalysisSpec {
     /// Mixing state sampled every this many steps (a multiple of the series cadence).
     #[serde(default)]
     pub mixing_every_steps: Option<u64>,
+    /// Time averages (pressure drop, mean height) start here, s; default: half the end time.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub average_from_s: Option<f64>,
 }
 
 fn default_neighbours() -> usize {
@@ -110,6 +119,7 @@ impl Default for AnalysisSpec {
             mixing_species: None,
             mixing_neighbours: default_neighbours(),
             mixing_every_steps: None,
+            average_from_s: None,
         }
     }
 }

@@ -27,6 +27,12 @@ fn fail(key: &str, message: impl Into<String>) -> SweepError {
 
 /// Expands `node` (found at `key` in the campaign file) into its points.
 pub fn expand(node: &SweepNode, key: &str) -> Result<Vec<Point>, SweepError> {
+    expand_node(node, key, false)
+}
+
+/// As [`expand`]; `in_zip`: the node is a direct child of a zip, whose axes may repeat a value (the zipped
+/// tuples must still differ, which the campaign checks as duplicate jobs).
+fn expand_node(node: &SweepNode, key: &str, in_zip: bool) -> Result<Vec<Point>, SweepError> {
     let kinds: Vec<&str> = [
         ("param", node.param.is_some()),
         ("grid", node.grid.is_some()),
@@ -52,7 +58,7 @@ pub fn expand(node: &SweepNode, key: &str) -> Result<Vec<Point>, SweepError> {
         ));
     }
     match kinds.as_slice() {
-        ["param"] => axis(node, key),
+        ["param"] => axis(node, key, in_zip),
         ["grid"] => grid(node.grid.as_deref().unwrap_or_default(), &format!("{key}.grid")),
         ["zip"] => zip(node.zip.as_deref().unwrap_or_default(), &format!("{key}.zip")),
         ["list"] => list(node.list.as_deref().unwrap_or_default(), &format!("{key}.list")),
@@ -109,7 +115,7 @@ pub fn param_keys(node: &SweepNode, key: &str) -> Vec<(String, String)> {
     out
 }
 
-fn axis(node: &SweepNode, key: &str) -> Result<Vec<Point>, SweepError> {
+fn axis(node: &SweepNode, key: &str, allow_repeats: bool) -> Result<Vec<Point>, SweepError> {
     let param = node.param.as_deref().unwrap_or_default();
     let param_key = format!("{key}.param");
     canonical_path(param).map_err(|m| fail(&param_key, m))?;
@@ -142,7 +148,7 @@ fn axis(node: &SweepNode, key: &str) -> Result<Vec<Point>, SweepError> {
                 "expected at least one value, got an empty list",
             ));
         }
-        for (k, v) in values.iter().enumerate() {
+        for (k, v) in values.iter().enumerate().filter(|_| !allow_repeats) {
             if let Some(first) = values[..k].iter().position(|w| w == v) {
                 return Err(fail(
                     &format!("{key}.values[{k}]"),
@@ -231,7 +237,7 @@ fn zip(children: &[SweepNode], key: &str) -> Result<Vec<Point>, SweepError> {
     let expanded: Vec<Vec<Point>> = children
         .iter()
         .enumerate()
-        .map(|(c, child)| expand(child, &format!("{key}[{c}]")))
+        .map(|(c, child)| expand_node(child, &format!("{key}[{c}]"), true))
         .collect::<Result<_, _>>()?;
     let len = expanded[0].len();
     if let Some((c, other)) = expanded.iter().enumerate().find(|(_, e)| e.len() != len) {

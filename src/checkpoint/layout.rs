@@ -22,6 +22,7 @@ use xxhash_rust::xxh3::Xxh3Default;
 use super::{CheckpointError, CheckpointMeta};
 use crate::engine::Vec3;
 use crate::engine::contacts::{ContactStore, WallId};
+use crate::engine::gas::coupled::{GasSnapshot, GasStepStats};
 use crate::engine::models::ContactHistory;
 use crate::engine::particles::{ParticleId, Particles, SpeciesId};
 use crate::engine::state::{RngState, SimState};
@@ -44,6 +45,12 @@ pub(crate) enum Rows {
     Fixed(usize),
     /// A scalar (rank-0) dataset.
     Scalar,
+    /// The number of gas cells (0 without a gas).
+    GasCells,
+    /// The number of gas faces normal to axis 0, 1 or 2 (0 without a gas, and for z on a 2-D grid: all faces).
+    GasFaces(u8),
+    /// One value with a gas, none without (a 1-D dataset of length 0 or 1).
+    GasScalar,
 }
 
 /// One dataset of the layout.
@@ -189,6 +196,21 @@ datasets! {
     rng_stream: u64 => "rng/stream", Rows::Scalar, 1, "1";
     rng_word_pos_hi: u64 => "rng/word_pos_hi", Rows::Scalar, 1, "1";
     rng_word_pos_lo: u64 => "rng/word_pos_lo", Rows::Scalar, 1, "1";
+
+    gas_pressure_pa: f64 => "gas/pressure_pa", Rows::GasCells, 1, "Pa";
+    gas_porosity: f64 => "gas/porosity", Rows::GasCells, 1, "1";
+    gas_velocity_x: f64 => "gas/velocity_x_m_per_s", Rows::GasFaces(0), 1, "m/s";
+    gas_velocity_y: f64 => "gas/velocity_y_m_per_s", Rows::GasFaces(1), 1, "m/s";
+    gas_velocity_z: f64 => "gas/velocity_z_m_per_s", Rows::GasFaces(2), 1, "m/s";
+    gas_reaction_x: f64 => "gas/drag_reaction_sum_x_n_per_m3", Rows::GasFaces(0), 1, "N/m3";
+    gas_reaction_y: f64 => "gas/drag_reaction_sum_y_n_per_m3", Rows::GasFaces(1), 1, "N/m3";
+    gas_reaction_z: f64 => "gas/drag_reaction_sum_z_n_per_m3", Rows::GasFaces(2), 1, "N/m3";
+    gas_time_s: f64 => "gas/time_s", Rows::GasScalar, 1, "s";
+    gas_reaction_steps: u32 => "gas/drag_reaction_steps", Rows::GasScalar, 1, "1";
+    gas_last_outer_iterations: u64 => "gas/last_step/outer_iterations", Rows::GasScalar, 1, "1";
+    gas_last_linear_iterations: u64 => "gas/last_step/linear_iterations", Rows::GasScalar, 1, "1";
+    gas_last_mass_imbalance: f64 => "gas/last_step/mass_imbalance", Rows::GasScalar, 1, "1";
+    gas_last_converged: u8 => "gas/last_step/converged", Rows::GasScalar, 1, "1";
 }
 
 /// Groups to create before the datasets, parents first.
@@ -199,6 +221,8 @@ pub(crate) const GROUPS: &[&str] = &[
     "contacts/walls",
     "walls",
     "rng",
+    "gas",
+    "gas/last_step",
 ];
 
 /// The scalar part of a checkpoint: the root attributes other than `format` and the checksum.
@@ -277,6 +301,7 @@ impl Arrays {
     /// The datasets of `state`. Call [`Arrays::check`] on the result before writing it.
     pub(crate) fn from_state(state: &SimState) -> Arrays {
         let p = &state.particles;
+        let gas = state.gas.as_ref();
         let mut pairs = HistoryColumns::default();
         for (_, _, h) in &state.contacts.pairs {
             pairs.push(h);
@@ -323,6 +348,21 @@ impl Arrays {
             rng_stream: vec![state.rng.stream],
             rng_word_pos_hi: vec![(state.rng.word_pos >> 64) as u64],
             rng_word_pos_lo: vec![state.rng.word_pos as u64],
+
+            gas_pressure_pa: gas.map(|g| g.pressure_pa.clone()).unwrap_or_default(),
+            gas_porosity: gas.map(|g| g.porosity.clone()).unwrap_or_default(),
+            gas_velocity_x: gas.map(|g| g.velocity_m_per_s[0].clone()).unwrap_or_default(),
+            gas_velocity_y: gas.map(|g| g.velocity_m_per_s[1].clone()).unwrap_or_default(),
+            gas_velocity_z: gas.map(|g| g.velocity_m_per_s[2].clone()).unwrap_or_default(),
+            gas_reaction_x: gas.map(|g| g.reaction_n_per_m3[0].clone()).unwrap_or_default(),
+            gas_reaction_y: gas.map(|g| g.reaction_n_per_m3[1].clone()).unwrap_or_default(),
+            gas_reaction_z: gas.map(|g| g.reaction_n_per_m3[2].clone()).unwrap_or_default(),
+            gas_time_s: gas.map(|g| g.time_s).into_iter().collect(),
+            gas_reaction_steps: gas.map(|g| g.reaction_steps).into_iter().collect(),
+            gas_last_outer_iterations: gas.map(|g| g.last.outer_iterations).into_iter().collect(),
+            gas_last_linear_iterations: gas.map(|g| g.last.linear_iterations).into_iter().collect(),
+            gas_last_mass_imbalance: gas.map(|g| g.last.mass_imbalance).into_iter().collect(),
+            gas_last_converged: gas.map(|g| u8::from(g.last.converged)).into_iter().collect(),
         }
     }
 
@@ -357,6 +397,23 @@ impl Arrays {
                     values[k]
                 ));
             }
+        }
+        let gas_scalars = self.gas_time_s.len();
+        if gas_scalars > 1 {
+            return Err(format!("/gas/time_s has {gas_scalars} elements, expected 0 or 1"));
+        }
+        let gas_lengths = [
+            ("gas/pressure_pa", self.gas_pressure_pa.len()),
+            ("gas/velocity_x_m_per_s", self.gas_velocity_x.len()),
+            ("gas/velocity_y_m_per_s", self.gas_velocity_y.len()),
+        ];
+        for (path, len) in gas_lengths {
+            if (len > 0) != (gas_scalars == 1) {
+                return Err(format!("/{path} has {len} values but /gas/time_s has {gas_scalars}"));
+            }
+        }
+        if let Some(&v) = self.gas_last_converged.first().filter(|&&v| v > 1) {
+            return Err(format!("/gas/last_step/converged is {v}, expected 0 or 1"));
         }
         if let Some(k) = self.wall_wall.iter().position(|&w| w as usize >= n_walls) {
             return Err(format!(
@@ -414,7 +471,22 @@ impl Arrays {
         let mut seed = [0u8; 32];
         seed.copy_from_slice(&self.rng_seed);
         let word_pos = (u128::from(self.rng_word_pos_hi[0]) << 64) | u128::from(self.rng_word_pos_lo[0]);
+        let gas = (self.gas_time_s.len() == 1).then(|| GasSnapshot {
+            pressure_pa: self.gas_pressure_pa,
+            velocity_m_per_s: [self.gas_velocity_x, self.gas_velocity_y, self.gas_velocity_z],
+            porosity: self.gas_porosity,
+            time_s: self.gas_time_s[0],
+            reaction_n_per_m3: [self.gas_reaction_x, self.gas_reaction_y, self.gas_reaction_z],
+            reaction_steps: self.gas_reaction_steps[0],
+            last: GasStepStats {
+                outer_iterations: self.gas_last_outer_iterations[0],
+                linear_iterations: self.gas_last_linear_iterations[0],
+                mass_imbalance: self.gas_last_mass_imbalance[0],
+                converged: self.gas_last_converged[0] == 1,
+            },
+        });
         SimState {
+            gas,
             step: header.step,
             time_s: header.time_s,
             dt_s: header.dt_s,

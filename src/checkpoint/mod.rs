@@ -31,7 +31,7 @@ use crate::engine::SimState;
 
 /// Version of the file layout. Bump it whenever a name, type, shape or the checksum definition changes; readers
 /// reject any other version with [`CheckpointError::Version`].
-pub const CHECKPOINT_FORMAT_VERSION: u32 = 1;
+pub const CHECKPOINT_FORMAT_VERSION: u32 = 2;
 
 /// Metadata stored beside the state.
 #[derive(Debug, Clone, PartialEq)]
@@ -407,6 +407,9 @@ fn expected_shape(spec: &DatasetSpec) -> String {
         Rows::Walls => "walls".to_string(),
         Rows::Fixed(n) => n.to_string(),
         Rows::Scalar => return "scalar".to_string(),
+        Rows::GasCells => "gas cells".to_string(),
+        Rows::GasFaces(a) => format!("gas faces normal to axis {a}"),
+        Rows::GasScalar => "0 or 1".to_string(),
     };
     if spec.width == 1 {
         format!("[{rows}]")
@@ -488,6 +491,25 @@ mod tests {
                 stream: 0xdead_beef_1234_5678,
                 word_pos: (1u128 << 70) + 12_345,
             },
+            // A 2 × 3 × 1 gas grid: 6 cells, 9 / 8 / 12 faces.
+            gas: Some(crate::engine::gas::coupled::GasSnapshot {
+                pressure_pa: (0..6).map(|k| 101.5 * k as f64 - 3.0).collect(),
+                velocity_m_per_s: [
+                    (0..9).map(|k| 0.1 * k as f64).collect(),
+                    (0..8).map(|k| -0.3 * k as f64 + 1e-17).collect(),
+                    vec![0.0; 12],
+                ],
+                porosity: vec![0.41, 0.5, 0.999, 1.0, 0.6, 0.45],
+                time_s: 0.012,
+                reaction_n_per_m3: [vec![1.5; 9], vec![-2.25; 8], vec![0.0; 12]],
+                reaction_steps: 7,
+                last: crate::engine::gas::coupled::GasStepStats {
+                    outer_iterations: 12,
+                    linear_iterations: 345,
+                    mass_imbalance: 1.25e-9,
+                    converged: true,
+                },
+            }),
         }
     }
 
@@ -977,6 +999,63 @@ mod tests {
             &[],
             &(state.rng.word_pos as u64).to_le_bytes(),
         );
+        let gas = state.gas.as_ref().expect("the sample has a gas");
+        ds(
+            &mut b,
+            "gas/pressure_pa",
+            &[gas.pressure_pa.len()],
+            &f(gas.pressure_pa.iter().copied()),
+        );
+        ds(
+            &mut b,
+            "gas/porosity",
+            &[gas.porosity.len()],
+            &f(gas.porosity.iter().copied()),
+        );
+        for (k, axis) in ["x", "y", "z"].iter().enumerate() {
+            let v = &gas.velocity_m_per_s[k];
+            ds(
+                &mut b,
+                &format!("gas/velocity_{axis}_m_per_s"),
+                &[v.len()],
+                &f(v.iter().copied()),
+            );
+        }
+        for (k, axis) in ["x", "y", "z"].iter().enumerate() {
+            let v = &gas.reaction_n_per_m3[k];
+            ds(
+                &mut b,
+                &format!("gas/drag_reaction_sum_{axis}_n_per_m3"),
+                &[v.len()],
+                &f(v.iter().copied()),
+            );
+        }
+        ds(&mut b, "gas/time_s", &[1], &gas.time_s.to_bits().to_le_bytes());
+        ds(
+            &mut b,
+            "gas/drag_reaction_steps",
+            &[1],
+            &gas.reaction_steps.to_le_bytes(),
+        );
+        ds(
+            &mut b,
+            "gas/last_step/outer_iterations",
+            &[1],
+            &gas.last.outer_iterations.to_le_bytes(),
+        );
+        ds(
+            &mut b,
+            "gas/last_step/linear_iterations",
+            &[1],
+            &gas.last.linear_iterations.to_le_bytes(),
+        );
+        ds(
+            &mut b,
+            "gas/last_step/mass_imbalance",
+            &[1],
+            &gas.last.mass_imbalance.to_bits().to_le_bytes(),
+        );
+        ds(&mut b, "gas/last_step/converged", &[1], &[u8::from(gas.last.converged)]);
 
         assert_eq!(stored, xxhash_rust::xxh3::xxh3_64(&b));
     }

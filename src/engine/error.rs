@@ -30,6 +30,8 @@ pub enum NumericalError {
         particle: ParticleId,
         position_m: Vec3,
     },
+    #[error("gas diverged at step {step}: {detail}; reduce dt or dem_steps_per_gas_step")]
+    GasDiverged { step: u64, detail: String },
     #[error("{count} contacts of the restored state found no neighbour-list slot (internal error)")]
     OrphanContacts { count: usize },
 }

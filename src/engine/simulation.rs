@@ -10,7 +10,7 @@ use std::time::{Duration, Instant};
 
 use super::contacts::AlignedHistory;
 use super::forces::{ForcePass, HalfKick, PairBuffers, RangePlan, compute_contact_forces};
-use super::gas::fluid_forces::FluidForces;
+use super::gas::coupled::GasCoupling;
 use super::geometry::{Domain, Gravity, Wall};
 use super::integrate::{InverseInertia, find_lost, kick_drift};
 use super::models::{ContactLaw, PairTable};
@@ -47,6 +47,8 @@ pub struct StageTimers {
     pub neighbor: Duration,
     pub force: Duration,
     pub integrate: Duration,
+    /// Gas steps (porosity, assembly, linear solves); the fluid forces on particles count under `force`.
+    pub gas: Duration,
 }
 
 pub struct Simulation {
@@ -74,11 +76,11 @@ pub struct Simulation {
     /// Threads of the per-step parallel force pass (same count as `pool`).
     team: Team,
     pub timers: StageTimers,
-    /// The gas's forces on the particles under a frozen gas field (a coupled simulation sets it). They are
+    /// The gas, when the scenario has one. Its forces on the particles (under the frozen gas field) are
     /// evaluated once per step, at the new positions and half-step velocities, and loaded into the force arrays
     /// before the contact pass adds onto them, so the pass itself is unchanged and any thread count gives the same
-    /// bits.
-    pub fluid: Option<FluidForces>,
+    /// bits. The gas steps after every `dem_steps_per_gas_step`-th DEM step.
+    pub gas: Option<Box<GasCoupling>>,
 }
 
 impl Simulation {
@@ -106,7 +108,7 @@ impl Simulation {
             inverse,
             ranges: RangePlan::default(),
             pending_drift: None,
-            fluid: None,
+            gas: None,
             accumulators_zeroed: false,
             steps_since_rebalance: 0,
             pool: make_pool(threads),
@@ -137,7 +139,7 @@ impl Simulation {
             inverse,
             ranges: RangePlan::default(),
             pending_drift: None,
-            fluid: None,
+            gas: None,
             accumulators_zeroed: false,
             steps_since_rebalance: 0,
             pool: make_pool(threads),
@@ -174,6 +176,7 @@ impl Simulation {
             wall_angle_rad: self.wall_angle_rad.clone(),
             contacts: self.history.to_store(&self.list),
             rng: self.rng,
+            gas: self.gas.as_ref().map(|g| g.snapshot()),
         }
     }
 
@@ -209,7 +212,19 @@ impl Simulation {
         // (a hand-over to a sleeping thread costs a wake-up). Every step
         // but the last hands its first half (kick + drift) of the next step to its own force loop; the state is
         // a whole step again when this returns.
-        let result = (0..n).try_for_each(|k| self.step_inner(k + 1 < n));
+        let result = (0..n).try_for_each(|k| {
+            // A gas step sees the particles at the end of a DEM step, so the step before it does not fuse the next
+            // step's drift into its force loop.
+            let gas_due = self
+                .gas
+                .as_ref()
+                .is_some_and(|g| (self.step + 1).is_multiple_of(g.dem_steps_per_gas_step));
+            self.step_inner(k + 1 < n && !gas_due)?;
+            if gas_due {
+                self.advance_gas()?;
+            }
+            Ok(())
+        });
         self.team.rest();
         if result.is_err() {
             // A failed step leaves no meaningful state; do not pretend the next step's drift is pending.
@@ -217,6 +232,31 @@ impl Simulation {
             self.accumulators_zeroed = false;
         }
         result
+    }
+
+    /// Attaches a gas (a coupled run); a restored run then restores the gas state with [`Self::restore_gas`].
+    pub fn attach_gas(&mut self, gas: GasCoupling) {
+        self.gas = Some(Box::new(gas));
+    }
+
+    /// Puts a checkpointed gas state into the attached gas.
+    pub fn restore_gas(&mut self, snap: &super::gas::coupled::GasSnapshot) -> Result<(), String> {
+        match self.gas.as_mut() {
+            Some(g) => g.restore(snap),
+            None => Err("the checkpoint holds a gas but the scenario has none".into()),
+        }
+    }
+
+    fn advance_gas(&mut self) -> Result<(), NumericalError> {
+        let t = Instant::now();
+        let gas = self.gas.as_mut().expect("called only with a gas");
+        let dt_gas = self.dt_s * gas.dem_steps_per_gas_step as f64;
+        let result = gas.advance(dt_gas, &self.particles.position_m, &self.particles.radius_m);
+        self.timers.gas += t.elapsed();
+        result.map(|_| ()).map_err(|detail| NumericalError::GasDiverged {
+            step: self.step,
+            detail,
+        })
     }
 
     /// Advances one time step.
@@ -276,7 +316,7 @@ impl Simulation {
         }
         self.steps_since_rebalance += 1;
         let t2 = Instant::now();
-        if let Some(fluid) = self.fluid.as_mut() {
+        if let Some(fluid) = self.gas.as_mut().map(|g| &mut g.fluid) {
             if !self.accumulators_zeroed {
                 self.particles.force_n.iter_mut().for_each(|f| *f = Vec3::zeros());
                 self.particles.torque_n_m.iter_mut().for_each(|t| *t = Vec3::zeros());

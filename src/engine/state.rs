@@ -7,6 +7,7 @@ use rand_chacha::rand_core::SeedableRng;
 
 use super::Vec3;
 use super::contacts::ContactStore;
+use super::gas::coupled::GasSnapshot;
 use super::models::ContactHistory;
 use super::particles::Particles;
 
@@ -51,6 +52,8 @@ pub struct SimState {
     pub wall_angle_rad: Vec<f64>,
     pub contacts: ContactStore,
     pub rng: RngState,
+    /// The gas of a coupled run.
+    pub gas: Option<GasSnapshot>,
 }
 
 /// Bit-level comparison of two states: `None` when every value is identical to the bit (`to_bits()` for floats),
@@ -144,6 +147,34 @@ pub fn first_difference(a: &SimState, b: &SimState) -> Option<String> {
             a.contacts.walls.len(),
             b.contacts.walls.len()
         ));
+    }
+    if a.gas.is_some() != b.gas.is_some() {
+        return Some("gas: present in one state only".into());
+    }
+    if let (Some(g), Some(h)) = (&a.gas, &b.gas) {
+        let gas = f("gas.time_s", g.time_s, h.time_s)
+            .or_else(|| scalars("gas.pressure_pa", &g.pressure_pa, &h.pressure_pa))
+            .or_else(|| scalars("gas.porosity", &g.porosity, &h.porosity))
+            .or_else(|| {
+                (0..3).find_map(|k| {
+                    scalars(
+                        &format!("gas.velocity_m_per_s[{k}]"),
+                        &g.velocity_m_per_s[k],
+                        &h.velocity_m_per_s[k],
+                    )
+                    .or_else(|| {
+                        scalars(
+                            &format!("gas.reaction_n_per_m3[{k}]"),
+                            &g.reaction_n_per_m3[k],
+                            &h.reaction_n_per_m3[k],
+                        )
+                    })
+                })
+            })
+            .or_else(|| (g.reaction_steps != h.reaction_steps).then(|| "gas.reaction_steps".to_string()));
+        if gas.is_some() {
+            return gas;
+        }
     }
     f("time_s", a.time_s, b.time_s)
         .or_else(|| f("dt_s", a.dt_s, b.dt_s))

@@ -210,6 +210,9 @@ pub fn run_campaign(campaign: &Campaign, source: &Path, out: &Path, opts: &Dispa
         progress,
     ))?;
 
+    if !campaign.spec.derived.is_empty() {
+        store_derived(&mut store, campaign_id, &campaign.spec.derived)?;
+    }
     let counts = store.status_counts(campaign_id).map_err(store_err)?;
     let count = |s: JobStatus| counts.get(s.as_str()).copied().unwrap_or(0);
     outcome.done = count(JobStatus::Done);
@@ -223,6 +226,21 @@ pub fn run_campaign(campaign: &Campaign, source: &Path, out: &Path, opts: &Dispa
         "dispatcher stopped"
     );
     Ok(outcome)
+}
+
+/// Computes the campaign-level metrics from the jobs done so far and stores them (replacing earlier values).
+pub fn store_derived(
+    store: &mut Store,
+    campaign_id: i64,
+    specs: &[crate::campaign::derived::DerivedSpec],
+) -> Result<(), Error> {
+    let (header, rows) = store.export_rows(campaign_id).map_err(store_err)?;
+    for d in crate::campaign::derived::compute(specs, &header, &rows) {
+        store
+            .insert_derived(campaign_id, &d.group_json, d.name, d.value, d.unit)
+            .map_err(store_err)?;
+    }
+    Ok(())
 }
 
 /// Refuses a campaign file that no longer produces jobs the directory's database holds: their parameters changed,

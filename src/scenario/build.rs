@@ -27,6 +27,8 @@ pub struct BuiltScenario {
     /// Shortest contact duration among the species pairs at the reference velocity (for reporting dt/t_c).
     pub contact_time_s: f64,
     pub rng: RngState,
+    /// The gas of a coupled run.
+    pub gas: Option<super::gas::GasSetup>,
 }
 
 struct Checker<'a> {
@@ -210,6 +212,24 @@ pub fn build(spec: ScenarioSpec, path: &Path) -> Result<BuiltScenario, ConfigErr
         }
     };
 
+    let gas = match &spec.gas {
+        None => None,
+        Some(g) => {
+            if spec.gravity.flip.is_some() {
+                return Err(c.fail("gas", "a gas with time-varying gravity (gravity.flip) is not supported"));
+            }
+            let fail = |key: String, message: String| c.fail(key, message);
+            Some(super::gas::build_gas(
+                g,
+                spec.domain.lo_m,
+                spec.domain.hi_m,
+                spec.domain.periodic,
+                spec.pseudo_2d,
+                spec.gravity.vector_m_per_s2,
+                &fail,
+            )?)
+        }
+    };
     let config = SimConfig {
         domain,
         pseudo_2d: spec.pseudo_2d,
@@ -228,6 +248,7 @@ pub fn build(spec: ScenarioSpec, path: &Path) -> Result<BuiltScenario, ConfigErr
         particles,
         dt_s,
         contact_time_s,
+        gas,
     })
 }
 

@@ -2,6 +2,7 @@
 //! engine's configuration and initial particles. The campaign layer will embed the same spec as its `base`.
 
 mod build;
+pub mod gas;
 pub mod spec;
 
 use std::path::{Path, PathBuf};

@@ -34,6 +34,9 @@ pub struct ScenarioSpec {
     /// Largest tolerated overlap as a fraction of the smaller radius before the run fails as numerically unstable.
     #[serde(default = "default_max_overlap_fraction")]
     pub max_overlap_fraction: f64,
+    /// A gas coupled to the particles (fluidized beds); absent: particles in vacuum.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub gas: Option<super::gas::GasSpec>,
 }
 
 fn default_max_overlap_fraction() -> f64 {

@@ -153,6 +153,7 @@ pub fn metrics(job: &JobSpec, built: &BuiltScenario, sim: &Simulation, series: &
             rows.iter().map(|&k| lacey[k]).collect(),
         ))
     };
+    let average_from_s = job.analysis.average_from_s.unwrap_or(0.5 * built.spec.time.end_time_s);
     let mut out = Vec::new();
     for name in &job.metrics {
         let meta = info(name).ok_or_else(|| Error::External(format!("unknown metric `{name}`")))?;
@@ -174,6 +175,17 @@ pub fn metrics(job: &JobSpec, built: &BuiltScenario, sim: &Simulation, series: &
             "time_to_90pct_max_lacey_s" => mixing_series()
                 .and_then(|(t, _, lacey)| analysis::fit::time_to_fraction_of_max(&t, &lacey, 0.9))
                 .map_or(f64::NAN, |t| t),
+            "mean_height_time_avg_m" => window(series, "mean_height_m", average_from_s).map_or(f64::NAN, |w| mean(&w)),
+            "bed_weight_per_area_pa" => bed_weight_per_area_pa(built, sim),
+            "pressure_drop_mean_pa" => {
+                window(series, "column_pressure_drop_pa", average_from_s).map_or(f64::NAN, |w| mean(&w))
+            }
+            "pressure_drop_std_pa" => {
+                window(series, "column_pressure_drop_pa", average_from_s).map_or(f64::NAN, |w| std_dev(&w))
+            }
+            "probe_pressure_drop_mean_pa" => {
+                window(series, "probe_pressure_drop_pa", average_from_s).map_or(f64::NAN, |w| mean(&w))
+            }
             other => return Err(Error::External(format!("metric `{other}` has no reducer"))),
         };
         out.push(Metric {
@@ -183,6 +195,44 @@ pub fn metrics(job: &JobSpec, built: &BuiltScenario, sim: &Simulation, series: &
         });
     }
     Ok(out)
+}
+
+/// The values of a series column from time `from_s` on (`None` if the column is missing or the window empty).
+fn window(series: &Series, column: &str, from_s: f64) -> Option<Vec<f64>> {
+    let t = series.column("time_s")?;
+    let v = series.column(column)?;
+    let w: Vec<f64> = t
+        .iter()
+        .zip(v)
+        .filter(|(t, v)| **t >= from_s && v.is_finite())
+        .map(|(_, v)| *v)
+        .collect();
+    (!w.is_empty()).then_some(w)
+}
+
+fn mean(v: &[f64]) -> f64 {
+    v.iter().sum::<f64>() / v.len() as f64
+}
+
+/// Population standard deviation.
+fn std_dev(v: &[f64]) -> f64 {
+    let m = mean(v);
+    (v.iter().map(|x| (x - m) * (x - m)).sum::<f64>() / v.len() as f64).sqrt()
+}
+
+/// W/A: the particles' weight over the area of the inlet side (seed 000 eq 2.74).
+fn bed_weight_per_area_pa(built: &BuiltScenario, sim: &Simulation) -> f64 {
+    let Some(gas) = sim.gas.as_ref() else {
+        return f64::NAN;
+    };
+    let Some((axis, _)) = gas.inlet_side() else {
+        return f64::NAN;
+    };
+    let g = built.spec.gravity.vector_m_per_s2;
+    let g = (g[0] * g[0] + g[1] * g[1] + g[2] * g[2]).sqrt();
+    let grid = &gas.solver.config.grid;
+    let area = grid.face_area_m2(axis) * (grid.cells() / grid.n[axis]) as f64;
+    sim.particles.mass_kg.iter().sum::<f64>() * g / area
 }
 
 /// Granular temperature (seed 000 eq 3.1) about the mean velocity of layers normal to gravity, each two particle

@@ -1,17 +1,44 @@
-//! A coupled gas–particle simulation: the DEM sub-cycles `dem_steps_per_gas_step` steps under a frozen gas field
+//! The gas coupled to the particles. The DEM sub-cycles `dem_steps_per_gas_step` steps under a frozen gas field
 //! (seed 001 Fig. 6.6: gas time step = n × particle time step), then the gas takes one step with the porosity of
 //! the particles at that moment and, as its momentum source, the particles' drag reaction averaged over the
-//! sub-steps (so the momentum the gas receives over a gas step is exactly what the particles lost to drag).
+//! sub-steps (CHOICE: averaged rather than the last sub-step's, so the momentum the gas receives over a gas step is
+//! exactly what the particles lost to drag over it).
+//!
+//! A [`GasCoupling`] lives inside a [`crate::engine::Simulation`], which calls [`GasCoupling::advance`] after every
+//! `dem_steps_per_gas_step`-th step; its state ([`GasSnapshot`]) is part of the checkpoint.
 
 use super::coupling::{PorosityMethod, porosity};
 use super::fluid_forces::FluidForces;
-use super::simple::{GasConfig, GasSolver, StepReport};
+use super::grid::{Boundary, side};
+use super::simple::{GasConfig, GasSolver};
+use crate::engine::Vec3;
 use crate::engine::models::drag::DragLaw;
-use crate::engine::{NumericalError, Simulation};
 
-pub struct CoupledSimulation {
-    pub dem: Simulation,
-    pub gas: GasSolver,
+/// How the last gas step went (kept in the checkpoint so a resumed run reports the same series).
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct GasStepStats {
+    pub outer_iterations: u64,
+    pub linear_iterations: u64,
+    pub mass_imbalance: f64,
+    pub converged: bool,
+}
+
+/// Everything of the gas a checkpoint needs: the solver state, and the reaction accumulated by the DEM sub-steps
+/// since the last gas step (the frozen field itself is the solver state, frozen again on restore).
+#[derive(Debug, Clone, PartialEq)]
+pub struct GasSnapshot {
+    pub pressure_pa: Vec<f64>,
+    pub velocity_m_per_s: [Vec<f64>; 3],
+    pub porosity: Vec<f64>,
+    pub time_s: f64,
+    pub reaction_n_per_m3: [Vec<f64>; 3],
+    pub reaction_steps: u32,
+    pub last: GasStepStats,
+}
+
+pub struct GasCoupling {
+    pub solver: GasSolver,
+    pub fluid: FluidForces,
     pub porosity_method: PorosityMethod,
     /// Porosity is not allowed below this (a cell over-filled by the split would otherwise reach 0).
     pub min_porosity: f64,
@@ -19,75 +46,185 @@ pub struct CoupledSimulation {
     /// A uniform force per unit volume on the gas besides drag, N/m³ (e.g. in a periodic box, the mean pressure
     /// gradient that carries the particles' weight, without which the mixture would accelerate for ever).
     pub gas_body_force_n_per_m3: [f64; 3],
-    pub last_gas_step: Option<StepReport>,
+    pub last: GasStepStats,
 }
 
-impl CoupledSimulation {
+impl GasCoupling {
+    /// The gas at rest (or at its boundary velocities) around particles at `positions_m`.
+    #[allow(clippy::too_many_arguments)]
     pub fn new(
-        mut dem: Simulation,
         gas_config: GasConfig,
         drag: DragLaw,
         porosity_method: PorosityMethod,
         min_porosity: f64,
         dem_steps_per_gas_step: u64,
+        positions_m: &[Vec3],
+        radii_m: &[f64],
     ) -> Result<Self, String> {
         if dem_steps_per_gas_step == 0 {
             return Err("dem_steps_per_gas_step: expected at least 1".into());
         }
-        let mut gas = GasSolver::new(gas_config)?;
-        let grid = gas.config.grid.clone();
-        gas.state.porosity = porosity(
-            &grid,
-            porosity_method,
-            &dem.particles.position_m,
-            &dem.particles.radius_m,
-            min_porosity,
+        let mut solver = GasSolver::new(gas_config)?;
+        let grid = solver.config.grid.clone();
+        solver.state.porosity = porosity(&grid, porosity_method, positions_m, radii_m, min_porosity);
+        let mut fluid = FluidForces::new(
+            grid,
+            drag,
+            solver.config.density_kg_per_m3,
+            solver.config.viscosity_pa_s,
         );
-        let mut fluid = FluidForces::new(grid, drag, gas.config.density_kg_per_m3, gas.config.viscosity_pa_s);
-        fluid.freeze(&gas.state.velocity_m_per_s, &gas.state.pressure_pa, &gas.state.porosity);
-        dem.fluid = Some(fluid);
-        Ok(CoupledSimulation {
-            dem,
-            gas,
+        fluid.freeze(
+            &solver.interstitial_velocity_m_per_s(),
+            &solver.state.pressure_pa,
+            &solver.state.porosity,
+        );
+        Ok(GasCoupling {
+            solver,
+            fluid,
             porosity_method,
             min_porosity,
             dem_steps_per_gas_step,
             gas_body_force_n_per_m3: [0.0; 3],
-            last_gas_step: None,
+            last: GasStepStats::default(),
         })
     }
 
-    /// One gas step: the DEM sub-cycles, then the gas advances by their total time.
-    pub fn advance(&mut self) -> Result<StepReport, NumericalError> {
-        self.dem.run_steps(self.dem_steps_per_gas_step)?;
-        let grid = self.gas.config.grid.clone();
-        let old_porosity = std::mem::replace(
-            &mut self.gas.state.porosity,
-            porosity(
-                &grid,
-                self.porosity_method,
-                &self.dem.particles.position_m,
-                &self.dem.particles.radius_m,
-                self.min_porosity,
-            ),
-        );
-        let fluid = self
-            .dem
-            .fluid
-            .as_mut()
-            .expect("a coupled simulation keeps its fluid forces");
-        let mut source = fluid.mean_reaction();
+    /// One gas step of `dt_s` after the DEM sub-steps: new porosity from `positions_m`, the mean drag reaction as
+    /// the momentum source, then the new field is frozen for the next sub-steps. Returns an error naming the
+    /// quantity if the gas field stops being finite.
+    pub fn advance(&mut self, dt_s: f64, positions_m: &[Vec3], radii_m: &[f64]) -> Result<GasStepStats, String> {
+        let grid = &self.solver.config.grid;
+        let new_porosity = porosity(grid, self.porosity_method, positions_m, radii_m, self.min_porosity);
+        let old_porosity = std::mem::replace(&mut self.solver.state.porosity, new_porosity);
+        let mut source = self.fluid.mean_reaction();
         for (a, s) in source.iter_mut().enumerate() {
             s.iter_mut().for_each(|v| *v += self.gas_body_force_n_per_m3[a]);
         }
-        let dt_gas = self.dem.dt_s * self.dem_steps_per_gas_step as f64;
-        let report = self.gas.step(dt_gas, &source, &Default::default(), &old_porosity);
-        fluid.freeze(
-            &self.gas.state.velocity_m_per_s,
-            &self.gas.state.pressure_pa,
-            &self.gas.state.porosity,
+        let report = self.solver.step(dt_s, &source, &Default::default(), &old_porosity);
+        let state = &self.solver.state;
+        if let Some(k) = state.pressure_pa.iter().position(|p| !p.is_finite()) {
+            return Err(format!("gas pressure of cell {k} is not finite"));
+        }
+        for (a, v) in state.velocity_m_per_s.iter().enumerate() {
+            if let Some(k) = v.iter().position(|u| !u.is_finite()) {
+                return Err(format!("gas velocity component {a} of face {k} is not finite"));
+            }
+        }
+        self.fluid.freeze(
+            &self.solver.interstitial_velocity_m_per_s(),
+            &state.pressure_pa,
+            &state.porosity,
         );
-        self.last_gas_step = Some(report);
-        Ok(report)
+        self.last = GasStepStats {
+            outer_iterations: report.outer_iterations as u64,
+            linear_iterations: (report.momentum.iterations + report.pressure.iterations) as u64,
+            mass_imbalance: report.mass_imbalance,
+            converged: report.converged,
+        };
+        Ok(self.last)
+    }
+
+    pub fn snapshot(&self) -> GasSnapshot {
+        let s = &self.solver.state;
+        GasSnapshot {
+            pressure_pa: s.pressure_pa.clone(),
+            velocity_m_per_s: s.velocity_m_per_s.clone(),
+            porosity: s.porosity.clone(),
+            time_s: s.time_s,
+            reaction_n_per_m3: self.fluid.reaction_n_per_m3.clone(),
+            reaction_steps: self.fluid.steps,
+            last: self.last,
+        }
+    }
+
+    /// Puts a checkpointed gas state back (the grid must match: checked by the checkpoint reader's shapes and
+    /// here against the solver's).
+    pub fn restore(&mut self, snap: &GasSnapshot) -> Result<(), String> {
+        let grid = &self.solver.config.grid;
+        if snap.pressure_pa.len() != grid.cells() || snap.porosity.len() != grid.cells() {
+            return Err(format!(
+                "the checkpoint's gas has {} cells, the scenario's grid {}",
+                snap.pressure_pa.len(),
+                grid.cells()
+            ));
+        }
+        for a in 0..3 {
+            if snap.velocity_m_per_s[a].len() != grid.faces(a) || snap.reaction_n_per_m3[a].len() != grid.faces(a) {
+                return Err(format!(
+                    "the checkpoint's gas has {} faces along axis {a}, the scenario's grid {}",
+                    snap.velocity_m_per_s[a].len(),
+                    grid.faces(a)
+                ));
+            }
+        }
+        let s = &mut self.solver.state;
+        s.pressure_pa.clone_from(&snap.pressure_pa);
+        s.velocity_m_per_s.clone_from(&snap.velocity_m_per_s);
+        s.porosity.clone_from(&snap.porosity);
+        s.time_s = snap.time_s;
+        let u = self.solver.interstitial_velocity_m_per_s();
+        let s = &self.solver.state;
+        self.fluid.freeze(&u, &s.pressure_pa, &s.porosity);
+        self.fluid.reaction_n_per_m3.clone_from(&snap.reaction_n_per_m3);
+        self.fluid.steps = snap.reaction_steps;
+        self.last = snap.last;
+        Ok(())
+    }
+
+    /// The axis and side of the first inlet: the bed's vertical and its bottom.
+    pub fn inlet_side(&self) -> Option<(usize, bool)> {
+        let grid = &self.solver.config.grid;
+        (0..grid.axes())
+            .flat_map(|a| [(a, false), (a, true)])
+            .find(|&(a, high)| matches!(grid.boundary[side(a, high)], Boundary::Inlet { .. }))
+    }
+
+    /// Mean pressure of the layer of cells `layer` along `axis`, Pa.
+    pub fn layer_pressure_pa(&self, axis: usize, layer: usize) -> f64 {
+        let grid = &self.solver.config.grid;
+        let p = &self.solver.state.pressure_pa;
+        let (mut sum, mut count) = (0.0, 0usize);
+        for k in 0..grid.n[2] {
+            for j in 0..grid.n[1] {
+                for i in 0..grid.n[0] {
+                    let idx = [i, j, k];
+                    if idx[axis] == layer {
+                        sum += p[grid.cell(idx)];
+                        count += 1;
+                    }
+                }
+            }
+        }
+        sum / count.max(1) as f64
+    }
+
+    /// p(inlet) − p(h_m): the pressure drop from the inlet face to height `h_m` above it, Pa; `None` without an
+    /// inlet. Pressures are layer means at cell centres, linear in between; below the first centre the line through
+    /// the first two is extended to the inlet face (the bed starts there), and above the last centre the pressure
+    /// is constant (the zero-gradient outlet).
+    pub fn pressure_drop_to_pa(&self, h_m: f64) -> Option<f64> {
+        let (axis, high) = self.inlet_side()?;
+        let grid = &self.solver.config.grid;
+        let n = grid.n[axis];
+        let layer = |k: usize| self.layer_pressure_pa(axis, if high { n - 1 - k } else { k });
+        let at = |s: f64| -> f64 {
+            // s: position in layer-centre units (layer k's centre at s = k).
+            if n == 1 {
+                return layer(0);
+            }
+            let s = s.min((n - 1) as f64);
+            let k = (s.floor().max(0.0) as usize).min(n - 2);
+            let w = s - k as f64;
+            (1.0 - w) * layer(k) + w * layer(k + 1)
+        };
+        let inlet = at(-0.5);
+        Some(inlet - at(h_m / grid.h_m[axis] - 0.5))
+    }
+
+    /// Pressure drop across the whole column, from the layer at the inlet to the layer at the far end, Pa.
+    pub fn column_pressure_drop_pa(&self) -> Option<f64> {
+        let (axis, _) = self.inlet_side()?;
+        let grid = &self.solver.config.grid;
+        self.pressure_drop_to_pa(grid.n[axis] as f64 * grid.h_m[axis])
     }
 }

@@ -18,7 +18,7 @@ use super::grid::{Boundary, Grid, side};
 use super::linsolve::{NONE, SolveReport, StencilSystem, bicgstab, conjugate_gradient};
 
 /// The convection scheme.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, schemars::JsonSchema)]
 #[serde(rename_all = "snake_case")]
 pub enum Convection {
     Upwind,
@@ -44,6 +44,20 @@ pub struct GasConfig {
     pub velocity_tolerance: f64,
     pub linear_tolerance: f64,
     pub max_linear_iterations: usize,
+    /// Boundary faces through which gas enters at their own velocity (jets through chosen distributor cells),
+    /// overriding what their side says.
+    pub inlet_faces: Vec<InletFace>,
+}
+
+/// One boundary face with a prescribed normal velocity.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct InletFace {
+    /// The axis the face is normal to.
+    pub axis: usize,
+    /// The face's index among that axis's faces (`Grid::face`).
+    pub face: usize,
+    /// Velocity along `axis`, m/s (positive along the axis: into the domain on the low side).
+    pub velocity_m_per_s: f64,
 }
 
 /// The gas state: everything a checkpoint needs.
@@ -118,6 +132,9 @@ pub struct GasSolver {
     face_of: [Vec<usize>; 3],
     /// Per component and face: ε_f A / a_P of the last momentum assembly (the pressure-correction coefficient).
     d: [Vec<f64>; 3],
+    /// Per component and face: gas enters here from a plenum (an inlet side or an inlet face), so the face's
+    /// porosity is 1 and its velocity is the superficial velocity.
+    plenum: [Vec<bool>; 3],
 }
 
 impl GasSolver {
@@ -142,12 +159,35 @@ impl GasSolver {
             }
         }
         let d = std::array::from_fn(|a| vec![0.0; grid.faces(a)]);
+        let mut plenum: [Vec<bool>; 3] = std::array::from_fn(|a| vec![false; grid.faces(a)]);
+        for a in 0..grid.axes() {
+            for idx in all_indices(grid.face_dims(a)) {
+                let along = idx[a];
+                if !grid.periodic(a) && (along == 0 || along == grid.n[a]) {
+                    let b = grid.boundary[side(a, along == grid.n[a])];
+                    plenum[a][grid.face(a, idx)] = matches!(b, Boundary::Inlet { .. });
+                }
+            }
+        }
+        for (k, f) in config.inlet_faces.iter().enumerate() {
+            let on_boundary = f.axis < grid.axes()
+                && f.face < grid.faces(f.axis)
+                && !grid.periodic(f.axis)
+                && matches!(face_index(grid, f.axis, f.face)[f.axis], x if x == 0 || x == grid.n[f.axis]);
+            if !on_boundary {
+                return Err(format!(
+                    "inlet face {k} is not a face on a non-periodic boundary of the grid"
+                ));
+            }
+            plenum[f.axis][f.face] = true;
+        }
         let mut solver = GasSolver {
             state: GasState::new(grid),
             config,
             unknown,
             face_of,
             d,
+            plenum,
         };
         solver.apply_boundary_velocities();
         Ok(solver)
@@ -180,6 +220,9 @@ impl GasSolver {
                     };
                 }
             }
+        }
+        for f in &self.config.inlet_faces {
+            self.state.velocity_m_per_s[f.axis][f.face] = f.velocity_m_per_s;
         }
     }
 
@@ -238,6 +281,9 @@ impl GasSolver {
 
     fn porosity_at_face(&self, a: usize, idx: [usize; 3]) -> f64 {
         let grid = &self.config.grid;
+        if self.plenum[a][grid.face(a, idx)] {
+            return 1.0;
+        }
         let eps = &self.state.porosity;
         let hi = (idx[a] < grid.n[a]).then_some(idx);
         let lo = step_cell(grid, idx, a, -1).filter(|_| idx[a] > 0 || grid.periodic(a));
@@ -544,6 +590,26 @@ impl GasSolver {
 }
 
 impl GasSolver {
+    /// The face velocities as the particles see them: interstitial everywhere. Faces where gas enters from a
+    /// plenum carry the superficial velocity (porosity 1 at the face); seen from the bed side they are U/ε of the
+    /// cell inside.
+    pub fn interstitial_velocity_m_per_s(&self) -> [Vec<f64>; 3] {
+        let grid = &self.config.grid;
+        let mut u = self.state.velocity_m_per_s.clone();
+        for a in 0..grid.axes() {
+            for (f, &is_plenum) in self.plenum[a].iter().enumerate() {
+                if is_plenum {
+                    let mut idx = face_index(grid, a, f);
+                    if idx[a] == grid.n[a] {
+                        idx[a] -= 1;
+                    }
+                    u[a][f] /= self.state.porosity[grid.cell(idx)];
+                }
+            }
+        }
+        u
+    }
+
     /// With an outlet, the pressure there is the reference: shifts p so that the mean pressure of the cells next to
     /// the outlet faces is 0 (the zero-gradient extrapolation to the face).
     fn fix_reference_pressure(&mut self) {

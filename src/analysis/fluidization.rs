@@ -1,0 +1,123 @@
+//! Minimum fluidization velocity from a sweep of gas velocities, two ways:
+//!
+//! - **pressure fluctuations** (seed 000 §4.1.2, Figs. 44–45): below u_mf the bed pressure drop is steady; at u_mf
+//!   its standard deviation jumps. u_mf is the first velocity above the largest jump of log σ(ΔP) between
+//!   neighbouring velocities of the sweep (so its resolution is the sweep's spacing; the velocity below the jump is
+//!   reported too);
+//! - **Ergun line** (seed 001 §7, "theoretical" u_mf): a straight line fitted to the mean ΔP of the packed-bed
+//!   points (those below the jump) meets the bed-weight line W/A.
+
+/// One job of the sweep: superficial gas velocity, mean and standard deviation of the bed pressure drop, and W/A.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SweepPoint {
+    pub velocity_m_per_s: f64,
+    pub pressure_drop_mean_pa: f64,
+    pub pressure_drop_std_pa: f64,
+    pub bed_weight_per_area_pa: f64,
+}
+
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct MinimumFluidization {
+    /// First velocity above the jump of σ(ΔP).
+    pub from_fluctuations_m_per_s: f64,
+    /// The velocity just below the jump.
+    pub below_jump_m_per_s: f64,
+    /// σ(ΔP) above over σ(ΔP) below the jump.
+    pub jump_ratio: f64,
+    /// Where the line through the packed-bed points meets W/A (NaN with fewer than two packed points).
+    pub from_ergun_line_m_per_s: f64,
+}
+
+/// u_mf from the sweep points (any order, at least three finite points; `None` otherwise).
+pub fn minimum_fluidization(points: &[SweepPoint]) -> Option<MinimumFluidization> {
+    let mut p: Vec<SweepPoint> = points
+        .iter()
+        .copied()
+        .filter(|q| {
+            q.velocity_m_per_s.is_finite() && q.pressure_drop_std_pa.is_finite() && q.pressure_drop_mean_pa.is_finite()
+        })
+        .collect();
+    if p.len() < 3 {
+        return None;
+    }
+    p.sort_by(|a, b| a.velocity_m_per_s.total_cmp(&b.velocity_m_per_s));
+    let floor = 1e-9
+        * p.iter()
+            .map(|q| q.pressure_drop_std_pa)
+            .fold(0.0, f64::max)
+            .max(f64::MIN_POSITIVE);
+    let log_std = |q: &SweepPoint| (q.pressure_drop_std_pa.max(0.0) + floor).ln();
+    let (k, jump) = (0..p.len() - 1)
+        .map(|k| (k, log_std(&p[k + 1]) - log_std(&p[k])))
+        .max_by(|a, b| a.1.total_cmp(&b.1))?;
+    let packed = &p[..=k];
+    let weight = p.iter().map(|q| q.bed_weight_per_area_pa).sum::<f64>() / p.len() as f64;
+    let from_ergun_line_m_per_s = if packed.len() >= 2 {
+        let (a, b) = fit_line(
+            &packed.iter().map(|q| q.velocity_m_per_s).collect::<Vec<_>>(),
+            &packed.iter().map(|q| q.pressure_drop_mean_pa).collect::<Vec<_>>(),
+        );
+        if a > 0.0 { (weight - b) / a } else { f64::NAN }
+    } else {
+        f64::NAN
+    };
+    Some(MinimumFluidization {
+        from_fluctuations_m_per_s: p[k + 1].velocity_m_per_s,
+        below_jump_m_per_s: p[k].velocity_m_per_s,
+        jump_ratio: jump.exp(),
+        from_ergun_line_m_per_s,
+    })
+}
+
+/// Least-squares line y = a x + b.
+fn fit_line(x: &[f64], y: &[f64]) -> (f64, f64) {
+    let n = x.len() as f64;
+    let mx = x.iter().sum::<f64>() / n;
+    let my = y.iter().sum::<f64>() / n;
+    let sxy: f64 = x.iter().zip(y).map(|(x, y)| (x - mx) * (y - my)).sum();
+    let sxx: f64 = x.iter().map(|x| (x - mx) * (x - mx)).sum();
+    let a = sxy / sxx;
+    (a, my - a * mx)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn point(u: f64, mean: f64, std: f64) -> SweepPoint {
+        SweepPoint {
+            velocity_m_per_s: u,
+            pressure_drop_mean_pa: mean,
+            pressure_drop_std_pa: std,
+            bed_weight_per_area_pa: 1000.0,
+        }
+    }
+
+    #[test]
+    fn the_jump_and_the_ergun_line_are_found() {
+        // Packed: ΔP = 500 u (+ noise-free), σ tiny; fluidized from 2.0 on: ΔP = W/A, σ large.
+        let pts = [
+            point(2.4, 1000.0, 60.0),
+            point(1.0, 500.0, 0.4),
+            point(1.5, 750.0, 0.6),
+            point(0.5, 250.0, 0.3),
+            point(2.0, 1000.0, 50.0),
+        ];
+        let m = minimum_fluidization(&pts).unwrap();
+        assert_eq!(m.from_fluctuations_m_per_s, 2.0);
+        assert_eq!(m.below_jump_m_per_s, 1.5);
+        assert!((m.jump_ratio - 50.0 / 0.6).abs() < 1e-9);
+        assert!(
+            (m.from_ergun_line_m_per_s - 2.0).abs() < 1e-12,
+            "{}",
+            m.from_ergun_line_m_per_s
+        );
+    }
+
+    #[test]
+    fn too_few_points_give_none() {
+        assert!(minimum_fluidization(&[point(1.0, 1.0, 1.0), point(2.0, 1.0, 2.0)]).is_none());
+        let with_nan = [point(1.0, 1.0, 1.0), point(2.0, 1.0, 2.0), point(3.0, f64::NAN, 5.0)];
+        assert!(minimum_fluidization(&with_nan).is_none());
+    }
+}

@@ -1,0 +1,262 @@
+//! `granflow report <campaign-dir>`: the validation report of a validation campaign (one with a `validation:`
+//! section) as Markdown — our numbers next to the source's, the command that reproduces them, the choices the
+//! source leaves open, every job's parameters and metrics, and a last line `verdict: pass` or
+//! `verdict: fail (<which checks>)`.
+
+use std::collections::BTreeMap;
+use std::fmt::Write;
+use std::path::Path;
+
+use serde_json::Value;
+
+use crate::campaign::validation::{CheckSpec, CheckValue};
+use crate::error::Error;
+use crate::orchestrate::dispatcher::{database_path, spec_copy_path};
+use crate::store::Store;
+
+fn store_err(e: crate::store::StoreError) -> Error {
+    Error::External(e.to_string())
+}
+
+/// One evaluated check.
+#[derive(Debug, Clone)]
+pub struct CheckResult {
+    pub name: String,
+    pub ours: f64,
+    pub expected: f64,
+    pub criterion: String,
+    pub samples: usize,
+    pub pass: bool,
+}
+
+fn same(a: &Value, b: &Value) -> bool {
+    match (a.as_f64(), b.as_f64()) {
+        (Some(x), Some(y)) => (x - y).abs() <= 1e-9 * x.abs().max(y.abs()),
+        _ => a == b,
+    }
+}
+
+fn evaluate(
+    check: &CheckSpec,
+    header: &[String],
+    rows: &[Vec<Value>],
+    derived: &[(String, String, Option<f64>)],
+) -> CheckResult {
+    let column = |name: &str| header.iter().position(|h| h == name);
+    let metric = |name: &str| {
+        header
+            .iter()
+            .position(|h| h == &format!("metric.{name}") || h.starts_with(&format!("metric.{name} [")))
+    };
+    let mut values = Vec::new();
+    match &check.value {
+        CheckValue::Metric(_) | CheckValue::Ratio(_) => {
+            let status = column("status");
+            for row in rows {
+                if status.is_some_and(|s| row[s] != Value::String("done".into())) {
+                    continue;
+                }
+                let matches = check
+                    .filter
+                    .iter()
+                    .all(|(k, v)| column(&format!("param.{k}")).is_some_and(|c| same(&row[c], v)));
+                if !matches {
+                    continue;
+                }
+                let get = |m: &str| metric(m).and_then(|c| row[c].as_f64()).unwrap_or(f64::NAN);
+                values.push(match &check.value {
+                    CheckValue::Metric(m) => get(m),
+                    CheckValue::Ratio([a, b]) => get(a) / get(b),
+                    CheckValue::Derived(_) => unreachable!(),
+                });
+            }
+        }
+        CheckValue::Derived(name) => {
+            for (group, n, value) in derived {
+                if n != name {
+                    continue;
+                }
+                let group: BTreeMap<String, Value> = serde_json::from_str(group).unwrap_or_default();
+                if check
+                    .filter
+                    .iter()
+                    .all(|(k, v)| group.get(k).is_some_and(|g| same(g, v)))
+                {
+                    values.push(value.unwrap_or(f64::NAN));
+                }
+            }
+        }
+    }
+    let ours = if values.is_empty() {
+        f64::NAN
+    } else {
+        values.iter().sum::<f64>() / values.len() as f64
+    };
+    let (pass, criterion) = match (check.tolerance_rel, check.range) {
+        (Some(t), _) => (
+            (ours / check.expected - 1.0).abs() <= t,
+            format!("within {:.3} %", 100.0 * t).replace(".000 %", " %"),
+        ),
+        (None, Some([lo, hi])) => (ours >= lo && ours <= hi, format!("in [{lo}, {hi}]")),
+        (None, None) => (false, "no criterion".into()),
+    };
+    CheckResult {
+        name: check.name.clone(),
+        ours,
+        expected: check.expected,
+        criterion,
+        samples: values.len(),
+        pass: pass && ours.is_finite(),
+    }
+}
+
+fn cell(v: &Value) -> String {
+    match v {
+        Value::Null => "".into(),
+        Value::Number(n) => n
+            .as_f64()
+            .map_or_else(|| n.to_string(), |x| format!("{}", (x * 1e6).round() / 1e6)),
+        Value::String(s) => s.clone(),
+        other => other.to_string(),
+    }
+}
+
+/// The Markdown report of the validation campaign in `dir`, and whether every check passed.
+pub fn report(dir: &Path) -> Result<(String, bool), Error> {
+    let campaign = crate::inspect::load_stored_campaign(dir)?;
+    let Some(validation) = campaign.spec.validation.clone() else {
+        return Err(Error::External(format!(
+            "campaign `{}` has no `validation:` section; `granflow report` is for validation campaigns",
+            campaign.spec.name
+        )));
+    };
+    let store = Store::open_read_only(database_path(dir)).map_err(store_err)?;
+    let id = store
+        .campaign_by_name(&campaign.spec.name)
+        .map_err(store_err)?
+        .ok_or_else(|| Error::External(format!("{}: no campaign in the database", dir.display())))?
+        .id;
+    let (header, rows) = store.export_rows(id).map_err(store_err)?;
+    let (_, derived_rows) = store
+        .query_sql(&format!(
+            "SELECT group_json, name, value, unit FROM derived WHERE campaign_id = {id} ORDER BY group_json, name"
+        ))
+        .map_err(store_err)?;
+    let derived: Vec<(String, String, Option<f64>)> = derived_rows
+        .iter()
+        .map(|r| {
+            (
+                r[0].as_str().unwrap_or_default().to_string(),
+                r[1].as_str().unwrap_or_default().to_string(),
+                r[2].as_f64(),
+            )
+        })
+        .collect();
+    let results: Vec<CheckResult> = validation
+        .checks
+        .iter()
+        .map(|c| evaluate(c, &header, &rows, &derived))
+        .collect();
+    let (_, timing_rows) = store
+        .query_sql(&format!(
+            "SELECT job_id, sim_time_s, wall_time_s FROM jobs WHERE campaign_id = {id} ORDER BY ordinal"
+        ))
+        .map_err(store_err)?;
+    let counts = store.status_counts(id).map_err(store_err)?;
+
+    let name = &campaign.spec.name;
+    let mut md = String::new();
+    let _ = writeln!(md, "# {} {}\n", validation.case, validation.title);
+    let _ = writeln!(
+        md,
+        "Campaign `{name}`: {} of {} jobs done. Reference: {}. Generated by `granflow report` (granflow {}).\n",
+        counts.get("done").copied().unwrap_or(0),
+        campaign.jobs.len(),
+        validation.source,
+        env!("CARGO_PKG_VERSION")
+    );
+    if !campaign.spec.description.trim().is_empty() {
+        let _ = writeln!(md, "{}\n", campaign.spec.description.trim());
+    }
+    let file = Path::new("campaigns/validation").join(format!("{name}.yaml"));
+    let campaign_file = if std::fs::read_to_string(&file).ok().as_deref() == Some(campaign.yaml.as_str()) {
+        file.display().to_string()
+    } else {
+        spec_copy_path(dir).display().to_string()
+    };
+    let _ = writeln!(md, "## Reproduce\n\n```sh");
+    let _ = writeln!(md, "granflow run {campaign_file} --out results/{name}");
+    let _ = writeln!(
+        md,
+        "granflow report results/{name} --out results/validation/{name}/REPORT.md\n```\n"
+    );
+    if !validation.choices.is_empty() {
+        let _ = writeln!(md, "## Choices the source leaves open\n");
+        for c in &validation.choices {
+            let _ = writeln!(md, "- {c}");
+        }
+        md.push('\n');
+    }
+    let _ = writeln!(md, "## Checks\n");
+    let _ = writeln!(md, "| check | ours | source | criterion | jobs/groups | result |");
+    let _ = writeln!(md, "|---|---|---|---|---|---|");
+    for r in &results {
+        let _ = writeln!(
+            md,
+            "| {} | {:.4} | {} | {} | {} | {} |",
+            r.name,
+            r.ours,
+            r.expected,
+            r.criterion,
+            r.samples,
+            if r.pass { "pass" } else { "FAIL" }
+        );
+    }
+    if !derived.is_empty() {
+        let _ = writeln!(md, "\n## Derived metrics\n");
+        let _ = writeln!(md, "| group | name | value | unit |");
+        let _ = writeln!(md, "|---|---|---|---|");
+        for r in &derived_rows {
+            let _ = writeln!(
+                md,
+                "| `{}` | {} | {} | {} |",
+                cell(&r[0]),
+                cell(&r[1]),
+                cell(&r[2]),
+                cell(&r[3])
+            );
+        }
+    }
+    let _ = writeln!(md, "\n## Jobs\n");
+    let shown: Vec<usize> = (0..header.len()).filter(|&k| k != 0).collect();
+    let _ = writeln!(
+        md,
+        "| {} | wall s per simulated s |",
+        shown
+            .iter()
+            .map(|&k| header[k].as_str())
+            .collect::<Vec<_>>()
+            .join(" | ")
+    );
+    let _ = writeln!(md, "|{}---|", "---|".repeat(shown.len()));
+    for (row, timing) in rows.iter().zip(&timing_rows) {
+        let per_s = match (timing[1].as_f64(), timing[2].as_f64()) {
+            (Some(sim), Some(wall)) if sim > 0.0 => format!("{:.1}", wall / sim),
+            _ => String::new(),
+        };
+        let _ = writeln!(
+            md,
+            "| {} | {per_s} |",
+            shown.iter().map(|&k| cell(&row[k])).collect::<Vec<_>>().join(" | ")
+        );
+    }
+    let failed: Vec<&str> = results.iter().filter(|r| !r.pass).map(|r| r.name.as_str()).collect();
+    let pass = failed.is_empty();
+    md.push('\n');
+    if pass {
+        md.push_str("verdict: pass\n");
+    } else {
+        let _ = writeln!(md, "verdict: fail ({})", failed.join("; "));
+    }
+    Ok((md, pass))
+}

@@ -1,0 +1,431 @@
+//! The `gas:` section of a scenario (a coupled gas–particle run: fluidized beds) and its validation into the gas
+//! solver's configuration.
+//!
+//! The gas grid covers the particle domain: `cells` along x, y, z; with `pseudo_2d: true` the grid is one cell deep
+//! (z = 1) and the cell depth is the domain's z extent — seed 000 §2.3.1's "pseudo-3-D" bed, whose depth should be
+//! one particle diameter (seed 000 prints 1 mm for 3 mm beads; seed 002 says one diameter).
+
+use serde::{Deserialize, Serialize};
+
+use super::ConfigError;
+use crate::engine::Vec3;
+use crate::engine::gas::coupled::GasCoupling;
+use crate::engine::gas::coupling::PorosityMethod;
+use crate::engine::gas::grid::side;
+use crate::engine::gas::simple::InletFace;
+use crate::engine::gas::{Boundary, Convection, GasConfig, Grid};
+use crate::engine::models::drag::DragLaw;
+
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, schemars::JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct GasSpec {
+    pub density_kg_per_m3: f64,
+    pub viscosity_pa_s: f64,
+    /// Gas cells along x, y, z (z = 1 for a pseudo-2-D bed). Seed 000: cells about 3 particle diameters wide.
+    pub cells: [usize; 3],
+    /// What bounds the gas on each side; an unset side is periodic where the domain is, else a no-slip wall.
+    #[serde(default)]
+    pub sides: SidesSpec,
+    /// Jets: boundary faces whose centres lie in a box get their own inflow velocity (seed 002's central jet).
+    #[serde(default)]
+    pub jets: Vec<JetSpec>,
+    #[serde(default = "default_drag")]
+    pub drag: DragLaw,
+    /// How particle volume becomes cell porosity (default `volume_split`).
+    #[serde(default)]
+    pub porosity: PorosityMethod,
+    /// Porosity is clamped to at least this.
+    #[serde(default = "default_min_porosity")]
+    pub min_porosity: f64,
+    /// DEM steps per gas step (seed 001: 20).
+    pub dem_steps_per_gas_step: u64,
+    /// Default `upwind` (seed 000 §2.2.2).
+    #[serde(default = "default_convection")]
+    pub convection: Convection,
+    #[serde(default)]
+    pub solver: GasSolverSpec,
+    /// Height above the inlet where the pressure-drop probe sits (seed 002 Fig. 3: 20 cm). The series always has
+    /// the whole-column drop too.
+    #[serde(default)]
+    pub pressure_probe_height_m: Option<f64>,
+}
+
+fn default_drag() -> DragLaw {
+    DragLaw::DiFelice
+}
+fn default_min_porosity() -> f64 {
+    // CHOICE: 0.2, below random close packing's 0.36 even for a bidisperse volume split in one cell.
+    0.2
+}
+fn default_convection() -> Convection {
+    Convection::Upwind
+}
+
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize, schemars::JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct SidesSpec {
+    #[serde(default)]
+    pub x_low: Option<SideSpec>,
+    #[serde(default)]
+    pub x_high: Option<SideSpec>,
+    #[serde(default)]
+    pub y_low: Option<SideSpec>,
+    #[serde(default)]
+    pub y_high: Option<SideSpec>,
+    #[serde(default)]
+    pub z_low: Option<SideSpec>,
+    #[serde(default)]
+    pub z_high: Option<SideSpec>,
+}
+
+impl SidesSpec {
+    fn get(&self, axis: usize, high: bool) -> Option<SideSpec> {
+        [
+            self.x_low,
+            self.x_high,
+            self.y_low,
+            self.y_high,
+            self.z_low,
+            self.z_high,
+        ][side(axis, high)]
+    }
+}
+
+const SIDE_NAMES: [&str; 6] = ["x_low", "x_high", "y_low", "y_high", "z_low", "z_high"];
+
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize, schemars::JsonSchema)]
+#[serde(rename_all = "snake_case", deny_unknown_fields)]
+pub enum SideSpec {
+    /// No-slip wall at rest.
+    Wall,
+    Periodic,
+    /// Zero-gradient outflow; the pressure there is the reference 0.
+    Outlet,
+    /// Uniform inflow into the domain at this superficial velocity (the distributor of a fluidized bed).
+    Inlet {
+        superficial_velocity_m_per_s: f64,
+    },
+}
+
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, schemars::JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct JetSpec {
+    /// The side the jet enters through (`y_low` for a bed's bottom).
+    pub side: String,
+    /// Faces of that side whose centres lie in [lo_m, hi_m] (the coordinate along the side's axis is ignored).
+    pub lo_m: [f64; 3],
+    pub hi_m: [f64; 3],
+    /// Inflow velocity into the domain, m/s.
+    pub superficial_velocity_m_per_s: f64,
+}
+
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, schemars::JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct GasSolverSpec {
+    #[serde(default = "d_relax_velocity")]
+    pub relax_velocity: f64,
+    #[serde(default = "d_relax_pressure")]
+    pub relax_pressure: f64,
+    #[serde(default = "d_outer")]
+    pub max_outer_iterations: usize,
+    #[serde(default = "d_mass_tol")]
+    pub mass_tolerance: f64,
+    #[serde(default = "d_velocity_tol")]
+    pub velocity_tolerance: f64,
+    #[serde(default = "d_linear_tol")]
+    pub linear_tolerance: f64,
+    #[serde(default = "d_linear_iter")]
+    pub max_linear_iterations: usize,
+}
+
+fn d_relax_velocity() -> f64 {
+    0.8
+}
+fn d_relax_pressure() -> f64 {
+    0.5
+}
+fn d_outer() -> usize {
+    50
+}
+fn d_mass_tol() -> f64 {
+    1e-5
+}
+fn d_velocity_tol() -> f64 {
+    1e-4
+}
+fn d_linear_tol() -> f64 {
+    1e-8
+}
+fn d_linear_iter() -> usize {
+    500
+}
+
+impl Default for GasSolverSpec {
+    fn default() -> Self {
+        GasSolverSpec {
+            relax_velocity: d_relax_velocity(),
+            relax_pressure: d_relax_pressure(),
+            max_outer_iterations: d_outer(),
+            mass_tolerance: d_mass_tol(),
+            velocity_tolerance: d_velocity_tol(),
+            linear_tolerance: d_linear_tol(),
+            max_linear_iterations: d_linear_iter(),
+        }
+    }
+}
+
+/// A validated gas section: everything needed to attach a gas to a simulation.
+#[derive(Debug, Clone, PartialEq)]
+pub struct GasSetup {
+    pub config: GasConfig,
+    pub drag: DragLaw,
+    pub porosity_method: PorosityMethod,
+    pub min_porosity: f64,
+    pub dem_steps_per_gas_step: u64,
+    pub pressure_probe_height_m: Option<f64>,
+}
+
+impl GasSetup {
+    /// The gas around particles at `positions_m`.
+    pub fn coupling(&self, positions_m: &[Vec3], radii_m: &[f64]) -> Result<GasCoupling, String> {
+        GasCoupling::new(
+            self.config.clone(),
+            self.drag,
+            self.porosity_method,
+            self.min_porosity,
+            self.dem_steps_per_gas_step,
+            positions_m,
+            radii_m,
+        )
+    }
+}
+
+type Fail<'a> = &'a dyn Fn(String, String) -> ConfigError;
+
+/// Checks the gas section against the domain and builds its configuration.
+pub fn build_gas(
+    spec: &GasSpec,
+    domain_lo_m: [f64; 3],
+    domain_hi_m: [f64; 3],
+    domain_periodic: [bool; 3],
+    pseudo_2d: bool,
+    gravity_m_per_s2: [f64; 3],
+    fail: Fail,
+) -> Result<GasSetup, ConfigError> {
+    let positive = |key: &str, v: f64| -> Result<(), ConfigError> {
+        if v.is_finite() && v > 0.0 {
+            Ok(())
+        } else {
+            Err(fail(
+                format!("gas.{key}"),
+                format!("expected a positive number, got {v}"),
+            ))
+        }
+    };
+    positive("density_kg_per_m3", spec.density_kg_per_m3)?;
+    positive("viscosity_pa_s", spec.viscosity_pa_s)?;
+    for a in 0..3 {
+        if spec.cells[a] == 0 {
+            return Err(fail(format!("gas.cells[{a}]"), "expected at least 1 cell".into()));
+        }
+    }
+    if pseudo_2d && spec.cells[2] != 1 {
+        return Err(fail(
+            "gas.cells[2]".into(),
+            format!("a pseudo-2-D bed has one gas cell in z, got {}", spec.cells[2]),
+        ));
+    }
+    if spec.cells.iter().product::<usize>() > 50_000_000 {
+        return Err(fail(
+            "gas.cells".into(),
+            "more than 5e7 cells: expected a smaller grid".into(),
+        ));
+    }
+    if spec.dem_steps_per_gas_step == 0 {
+        return Err(fail("gas.dem_steps_per_gas_step".into(), "expected at least 1".into()));
+    }
+    if !(spec.min_porosity.is_finite() && spec.min_porosity > 0.0 && spec.min_porosity < 1.0) {
+        return Err(fail(
+            "gas.min_porosity".into(),
+            format!("expected 0 < value < 1, got {}", spec.min_porosity),
+        ));
+    }
+    let s = &spec.solver;
+    for (key, v) in [
+        ("relax_velocity", s.relax_velocity),
+        ("relax_pressure", s.relax_pressure),
+    ] {
+        if !(v.is_finite() && v > 0.0 && v <= 1.0) {
+            return Err(fail(
+                format!("gas.solver.{key}"),
+                format!("expected 0 < value <= 1, got {v}"),
+            ));
+        }
+    }
+    for (key, v) in [
+        ("mass_tolerance", s.mass_tolerance),
+        ("velocity_tolerance", s.velocity_tolerance),
+        ("linear_tolerance", s.linear_tolerance),
+    ] {
+        positive(&format!("solver.{key}"), v)?;
+    }
+    for (key, v) in [
+        ("max_outer_iterations", s.max_outer_iterations),
+        ("max_linear_iterations", s.max_linear_iterations),
+    ] {
+        if v == 0 {
+            return Err(fail(format!("gas.solver.{key}"), "expected at least 1".into()));
+        }
+    }
+    // A grid one cell deep carries no z velocity and has no z sides (Grid::two_d).
+    let two_d = spec.cells[2] == 1;
+    let mut boundary = [Boundary::Wall {
+        velocity_m_per_s: [0.0; 3],
+    }; 6];
+    for a in 0..3 {
+        for high in [false, true] {
+            let name = SIDE_NAMES[side(a, high)];
+            let given = spec.sides.get(a, high);
+            if two_d && a == 2 {
+                if given.is_some() {
+                    return Err(fail(
+                        format!("gas.sides.{name}"),
+                        "a pseudo-2-D gas has no z sides (it is one cell deep)".into(),
+                    ));
+                }
+                continue;
+            }
+            let side_spec = given.unwrap_or(if domain_periodic[a] {
+                SideSpec::Periodic
+            } else {
+                SideSpec::Wall
+            });
+            if matches!(side_spec, SideSpec::Periodic) != domain_periodic[a] {
+                return Err(fail(
+                    format!("gas.sides.{name}"),
+                    format!(
+                        "the gas is periodic along an axis exactly when the particle domain is (domain.periodic[{a}] is {})",
+                        domain_periodic[a]
+                    ),
+                ));
+            }
+            let inward = if high { -1.0 } else { 1.0 };
+            boundary[side(a, high)] = match side_spec {
+                SideSpec::Wall => Boundary::Wall {
+                    velocity_m_per_s: [0.0; 3],
+                },
+                SideSpec::Periodic => Boundary::Periodic,
+                SideSpec::Outlet => Boundary::Outlet,
+                SideSpec::Inlet {
+                    superficial_velocity_m_per_s: v,
+                } => {
+                    if !v.is_finite() || v < 0.0 {
+                        return Err(fail(
+                            format!("gas.sides.{name}.inlet.superficial_velocity_m_per_s"),
+                            format!("expected a velocity >= 0 into the domain, got {v}"),
+                        ));
+                    }
+                    let mut u = [0.0; 3];
+                    u[a] = inward * v;
+                    Boundary::Inlet { velocity_m_per_s: u }
+                }
+            };
+        }
+    }
+    let h_m: [f64; 3] = std::array::from_fn(|a| (domain_hi_m[a] - domain_lo_m[a]) / spec.cells[a] as f64);
+    let grid = Grid {
+        n: spec.cells,
+        h_m,
+        origin_m: domain_lo_m,
+        boundary,
+    };
+    let mut inlet_faces = Vec::new();
+    for (k, jet) in spec.jets.iter().enumerate() {
+        let key = |f: &str| format!("gas.jets[{k}].{f}");
+        let Some(index) = SIDE_NAMES.iter().position(|n| *n == jet.side) else {
+            return Err(fail(
+                key("side"),
+                format!("unknown side `{}`; expected one of {}", jet.side, SIDE_NAMES.join(", ")),
+            ));
+        };
+        let (axis, high) = (index / 2, index % 2 == 1);
+        if axis >= grid.axes() || grid.periodic(axis) {
+            return Err(fail(
+                key("side"),
+                format!("side `{}` is not a boundary of this gas grid", jet.side),
+            ));
+        }
+        if !jet.superficial_velocity_m_per_s.is_finite() || jet.superficial_velocity_m_per_s < 0.0 {
+            return Err(fail(
+                key("superficial_velocity_m_per_s"),
+                format!(
+                    "expected a velocity >= 0 into the domain, got {}",
+                    jet.superficial_velocity_m_per_s
+                ),
+            ));
+        }
+        let dims = grid.face_dims(axis);
+        let along = if high { grid.n[axis] } else { 0 };
+        let before = inlet_faces.len();
+        for kk in 0..dims[2] {
+            for j in 0..dims[1] {
+                for i in 0..dims[0] {
+                    let idx = [i, j, kk];
+                    if idx[axis] != along {
+                        continue;
+                    }
+                    let c = grid.face_centre_m(axis, idx);
+                    let inside = (0..3)
+                        .filter(|&b| b != axis && !(two_d && b == 2))
+                        .all(|b| c[b] >= jet.lo_m[b] && c[b] <= jet.hi_m[b]);
+                    if inside {
+                        inlet_faces.push(InletFace {
+                            axis,
+                            face: grid.face(axis, idx),
+                            velocity_m_per_s: if high { -1.0 } else { 1.0 } * jet.superficial_velocity_m_per_s,
+                        });
+                    }
+                }
+            }
+        }
+        if inlet_faces.len() == before {
+            return Err(fail(
+                key("lo_m"),
+                "the box holds no face centre of that side; widen it to at least one gas cell".into(),
+            ));
+        }
+    }
+    if let Some(h) = spec.pressure_probe_height_m {
+        positive("pressure_probe_height_m", h)?;
+        if !boundary.iter().any(|b| matches!(b, Boundary::Inlet { .. })) {
+            return Err(fail(
+                "gas.pressure_probe_height_m".into(),
+                "the probe height is measured from an inlet side; no side is an inlet".into(),
+            ));
+        }
+    }
+    let config = GasConfig {
+        grid,
+        density_kg_per_m3: spec.density_kg_per_m3,
+        viscosity_pa_s: spec.viscosity_pa_s,
+        gravity_m_per_s2,
+        convection: spec.convection,
+        relax_velocity: s.relax_velocity,
+        relax_pressure: s.relax_pressure,
+        max_outer_iterations: s.max_outer_iterations,
+        mass_tolerance: s.mass_tolerance,
+        velocity_tolerance: s.velocity_tolerance,
+        linear_tolerance: s.linear_tolerance,
+        max_linear_iterations: s.max_linear_iterations,
+        inlet_faces,
+    };
+    config.grid.check().map_err(|m| fail("gas.cells".into(), m))?;
+    Ok(GasSetup {
+        config,
+        drag: spec.drag,
+        porosity_method: spec.porosity,
+        min_porosity: spec.min_porosity,
+        dem_steps_per_gas_step: spec.dem_steps_per_gas_step,
+        pressure_probe_height_m: spec.pressure_probe_height_m,
+    })
+}

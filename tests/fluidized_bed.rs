@@ -1,0 +1,182 @@
+//! A coupled fluidized bed through the real binary: exact restart with the gas in the checkpoint (stopping between
+//! two gas steps, switching thread counts across the restart), the pressure-drop series, and bad gas input.
+
+mod common;
+
+use std::path::Path;
+
+use common::granflow;
+use granflow::checkpoint::CheckpointSeries;
+use granflow::engine::state::{SimState, first_difference};
+
+/// A small pseudo-2-D bed: 100 beads of 2.7 mm, 10 layers, gas inflow 2.5 m/s from below (fluidized).
+fn bed(end_time_s: f64, extra: &str) -> String {
+    format!(
+        r#"
+name: small-bed
+domain: {{ lo_m: [0.0, 0.0, 0.0], hi_m: [0.03, 0.1, 0.0027], periodic: [true, false, false] }}
+pseudo_2d: true
+gravity: {{ vector_m_per_s2: [0.0, -9.81, 0.0] }}
+species:
+  - {{ name: glass, radius_m: 0.00135, density_kg_per_m3: 2000.0, youngs_modulus_pa: 5.0e7, poisson_ratio: 0.33, friction_coefficient: 0.3 }}
+contact: {{ normal: {{ hertz: {{ restitution: 0.9 }} }}, tangential: mindlin }}
+walls: [ {{ box: {{ species: glass }} }} ]
+fill:
+  - lattice: {{ species: glass, spacing_m: 0.003, lo_m: [0.0, 0.0015, 0.0], hi_m: [0.03, 0.0315, 0.0027], origin_m: [0.0015, 0.0015, 0.00135] }}
+gas:
+  density_kg_per_m3: 1.23
+  viscosity_pa_s: 1.8e-5
+  cells: [4, 12, 1]
+  sides: {{ y_low: {{ inlet: {{ superficial_velocity_m_per_s: 2.5 }} }}, y_high: outlet }}
+  dem_steps_per_gas_step: 7
+  pressure_probe_height_m: 0.02
+{extra}
+time: {{ dt_s: 1.0e-5, end_time_s: {end_time_s} }}
+output: {{ checkpoint_every_steps: 1000, keep_checkpoints: 2, series_every_steps: 70 }}
+"#
+    )
+}
+
+fn final_state(dir: &Path) -> SimState {
+    let loaded = CheckpointSeries::new(dir, 2)
+        .latest_valid()
+        .expect("lists")
+        .expect("a checkpoint exists");
+    loaded.state
+}
+
+fn run_ok(args: &[&str], cwd: &Path) -> String {
+    let out = granflow(args, cwd);
+    assert!(
+        out.status.success(),
+        "granflow {args:?} failed: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    String::from_utf8_lossy(&out.stderr).into_owned()
+}
+
+#[test]
+fn a_fluidized_bed_restarts_bit_identically_with_its_gas() {
+    let tmp = tempfile::tempdir().expect("temp dir");
+    let dir = tmp.path();
+    std::fs::write(dir.join("bed.yaml"), bed(0.03, "")).expect("write scenario");
+    run_ok(&["simulate", "bed.yaml", "--out", "whole", "--quiet"], dir);
+    // 1503 steps: the stop falls 5 DEM steps into a gas step (the drag reaction sum is mid-way).
+    run_ok(
+        &[
+            "simulate",
+            "bed.yaml",
+            "--out",
+            "split",
+            "--max-steps",
+            "1503",
+            "--threads",
+            "2",
+            "--quiet",
+        ],
+        dir,
+    );
+    let middle = final_state(&dir.join("split"));
+    assert_eq!(middle.step, 1503);
+    let gas = middle.gas.as_ref().expect("the checkpoint holds the gas");
+    assert_eq!(
+        gas.reaction_steps, 5,
+        "the restart must carry a partly accumulated reaction"
+    );
+    let log = run_ok(&["simulate", "bed.yaml", "--out", "split", "--threads", "1"], dir);
+    assert!(log.contains("resuming from"), "{log}");
+    let whole = final_state(&dir.join("whole"));
+    let split = final_state(&dir.join("split"));
+    assert_eq!(whole.step, 3000);
+    if let Some(diff) = first_difference(&whole, &split) {
+        panic!("restarted bed differs from the uninterrupted one: {diff}");
+    }
+    let a = std::fs::read_to_string(dir.join("whole/series.csv")).unwrap();
+    let b = std::fs::read_to_string(dir.join("split/series.csv")).unwrap();
+    assert_eq!(a, b, "the series of the restarted run differs");
+    // The gas moved and the bed felt it: a pressure drop across the bed, gas faster than the inflow inside it.
+    let last = a.lines().last().unwrap();
+    let header: Vec<&str> = a.lines().next().unwrap().split(',').collect();
+    let value = |name: &str| -> f64 {
+        let k = header
+            .iter()
+            .position(|h| *h == name)
+            .unwrap_or_else(|| panic!("column {name}"));
+        last.split(',').nth(k).unwrap().parse().unwrap()
+    };
+    assert!(value("column_pressure_drop_pa") > 100.0, "{last}");
+    assert!(
+        value("probe_pressure_drop_pa") > 0.0 && value("probe_pressure_drop_pa") < value("column_pressure_drop_pa")
+    );
+    assert!(value("gas_outer_iterations") >= 1.0);
+}
+
+#[test]
+fn bad_gas_input_is_rejected_with_its_key_before_anything_is_written() {
+    let cases: &[(&str, &str, &str)] = &[
+        ("cells: [4, 12, 1]", "cells: [4, 12, 2]", "gas.cells[2]"),
+        ("y_high: outlet", "y_high: outlet, x_low: wall", "gas.sides.x_low"),
+        (
+            "dem_steps_per_gas_step: 7",
+            "dem_steps_per_gas_step: 0",
+            "gas.dem_steps_per_gas_step",
+        ),
+        (
+            "superficial_velocity_m_per_s: 2.5",
+            "superficial_velocity_m_per_s: -1.0",
+            "gas.sides.y_low.inlet.superficial_velocity_m_per_s",
+        ),
+        ("viscosity_pa_s: 1.8e-5", "viscosity_pa_s: 0.0", "gas.viscosity_pa_s"),
+        ("drag: di_felice", "drag: di_felise", "di_felice"),
+    ];
+    let tmp = tempfile::tempdir().expect("temp dir");
+    let dir = tmp.path();
+    for (k, (from, to, expected)) in cases.iter().enumerate() {
+        let base = bed(
+            0.01,
+            "  drag: di_felice\n  jets: [ { side: y_low, lo_m: [0.012, 0.0, 0.0], hi_m: [0.018, 0.0, 0.0027], superficial_velocity_m_per_s: 10.0 } ]",
+        );
+        assert!(base.contains(from), "case {k}: `{from}` not in the base");
+        let text = base.replacen(from, to, 1);
+        let file = format!("bad{k}.yaml");
+        std::fs::write(dir.join(&file), text).unwrap();
+        let out = granflow(&["simulate", &file, "--out", &format!("out{k}"), "--quiet"], dir);
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "case {k}: {err}");
+        assert!(
+            err.contains(expected) && err.contains(&file),
+            "case {k}: expected `{expected}` in: {err}"
+        );
+        assert!(!dir.join(format!("out{k}")).exists(), "case {k}: wrote output");
+    }
+    // A jet box holding no face of its side.
+    let text = bed(
+        0.01,
+        "  jets: [ { side: y_low, lo_m: [0.0101, 0.0, 0.0], hi_m: [0.0102, 0.0, 0.0027], superficial_velocity_m_per_s: 10.0 } ]",
+    );
+    std::fs::write(dir.join("jet.yaml"), text).unwrap();
+    let out = granflow(&["simulate", "jet.yaml", "--out", "jet", "--quiet"], dir);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        err.contains("gas.jets[0].lo_m") && err.contains("no face centre"),
+        "{err}"
+    );
+}
+
+#[test]
+fn a_jet_carries_its_own_inflow() {
+    let tmp = tempfile::tempdir().expect("temp dir");
+    let dir = tmp.path();
+    // A central jet over the middle two of four cells (face centres at x = 11.25 and 18.75 mm).
+    let text = bed(
+        0.005,
+        "  jets: [ { side: y_low, lo_m: [0.01, 0.0, 0.0], hi_m: [0.02, 0.0, 0.0027], superficial_velocity_m_per_s: 10.0 } ]",
+    );
+    std::fs::write(dir.join("jet.yaml"), text).unwrap();
+    run_ok(&["simulate", "jet.yaml", "--out", "jet", "--quiet"], dir);
+    let state = final_state(&dir.join("jet"));
+    let gas = state.gas.expect("gas");
+    // Bottom faces of v (normal to y): the first row of 4.
+    let bottom = &gas.velocity_m_per_s[1][..4];
+    assert_eq!(bottom, &[2.5, 10.0, 10.0, 2.5], "inlet faces: {bottom:?}");
+}

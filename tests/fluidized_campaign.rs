@@ -1,0 +1,116 @@
+//! A smoke fluidized-bed campaign through the real binary (a few hundred steps per job): the gas metrics are
+//! stored, the campaign-level u_mf is derived per group and stored in `derived`, and `granflow report` writes a
+//! report whose first line names the case and whose last line is the verdict.
+
+mod common;
+
+use common::granflow;
+
+fn campaign(check_range: &str) -> String {
+    format!(
+        r#"
+name: bed-smoke
+description: A 100-bead pseudo-2-D bed at three inlet velocities, 300 steps each.
+base:
+  domain: {{ lo_m: [0.0, 0.0, 0.0], hi_m: [0.03, 0.1, 0.0027], periodic: [true, false, false] }}
+  pseudo_2d: true
+  gravity: {{ vector_m_per_s2: [0.0, -9.81, 0.0] }}
+  species:
+    - {{ name: glass, radius_m: 0.00135, density_kg_per_m3: 2000.0, youngs_modulus_pa: 1.0e7, poisson_ratio: 0.33, friction_coefficient: 0.3 }}
+  contact: {{ normal: {{ hertz: {{ restitution: 0.9 }} }}, tangential: mindlin }}
+  walls: [ {{ box: {{ species: glass }} }} ]
+  fill:
+    - lattice: {{ species: glass, spacing_m: 0.003, lo_m: [0.0, 0.0015, 0.0], hi_m: [0.03, 0.0315, 0.0027], origin_m: [0.0015, 0.0015, 0.00135] }}
+  gas:
+    density_kg_per_m3: 1.23
+    viscosity_pa_s: 1.8e-5
+    cells: [4, 12, 1]
+    sides: {{ y_low: {{ inlet: {{ superficial_velocity_m_per_s: 1.0 }} }}, y_high: outlet }}
+    dem_steps_per_gas_step: 5
+  time: {{ dt_s: 1.0e-5, end_time_s: 0.003 }}
+  output: {{ series_every_steps: 5 }}
+sweep:
+  grid:
+    - {{ param: species.0.density_kg_per_m3, name: density_kg_per_m3, values: [1000.0, 2000.0] }}
+    - {{ param: gas.sides.y_low.inlet.superficial_velocity_m_per_s, name: u_m_per_s, values: [0.3, 1.0, 3.0] }}
+metrics: [pressure_drop_mean_pa, pressure_drop_std_pa, bed_weight_per_area_pa, mean_height_time_avg_m]
+analysis: {{ average_from_s: 0.001 }}
+derived:
+  - minimum_fluidization_velocity: {{ velocity_param: u_m_per_s }}
+executor: {{ local: {{ max_parallel: 2 }} }}
+validation:
+  case: X1
+  title: smoke
+  source: nothing (a plumbing test)
+  choices: ["300 steps only"]
+  checks:
+    - name: "bed weight per area, rho = 2000"
+      value: {{ metric: bed_weight_per_area_pa }}
+      where: {{ density_kg_per_m3: 2000.0 }}
+      expected: 0.0
+      range: {check_range}
+    - name: "u_mf found for rho = 1000"
+      value: {{ derived: u_mf_pressure_fluctuation_m_per_s }}
+      where: {{ density_kg_per_m3: 1000.0 }}
+      expected: 1.0
+      range: [0.3, 3.0]
+"#
+    )
+}
+
+#[test]
+fn a_fluidized_bed_campaign_stores_gas_metrics_derives_u_mf_and_reports() {
+    let tmp = tempfile::tempdir().expect("temp dir");
+    let dir = tmp.path();
+    // W/A of 100 beads of 2.7 mm at 2000 kg/m3 over 30 mm x 2.7 mm: 100 x 2.0612e-5 kg x 9.81 / 8.1e-5 m2 = 249.6 Pa.
+    std::fs::write(dir.join("bed.yaml"), campaign("[249.0, 250.2]")).unwrap();
+    let out = granflow(&["run", "bed.yaml", "--out", "bed", "--quiet"], dir);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+
+    let sql = |q: &str| -> String {
+        let out = granflow(&["query", "bed", "--sql", q, "--format", "csv"], dir);
+        assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+        String::from_utf8_lossy(&out.stdout).into_owned()
+    };
+    let metrics = sql("SELECT count(*) FROM metrics WHERE value IS NOT NULL");
+    assert!(metrics.contains("24"), "4 metrics x 6 jobs: {metrics}");
+    // The packed bed at 0.3 m/s carries less than its weight; every pressure drop is positive.
+    let dp = sql(
+        "SELECT p.value_real, m.value FROM metrics m JOIN params p ON p.job_id = m.job_id \
+         WHERE m.name = 'pressure_drop_mean_pa' AND p.name = 'u_m_per_s' ORDER BY p.value_real",
+    );
+    let values: Vec<(f64, f64)> = dp
+        .lines()
+        .skip(1)
+        .map(|l| {
+            let mut f = l.split(',').map(|x| x.parse::<f64>().unwrap());
+            (f.next().unwrap(), f.next().unwrap())
+        })
+        .collect();
+    assert_eq!(values.len(), 6);
+    assert!(values.iter().all(|&(_, p)| p > 0.0), "{values:?}");
+    assert!(values[0].1 < values[5].1, "ΔP grows with the gas velocity: {values:?}");
+    // One u_mf row per density group, four names each.
+    let derived = sql("SELECT group_json, name, value FROM derived ORDER BY group_json, name");
+    assert_eq!(derived.lines().count(), 1 + 2 * 4, "{derived}");
+    assert!(derived.contains("density_kg_per_m3") && derived.contains("u_mf_pressure_fluctuation_m_per_s"));
+
+    let out = granflow(&["report", "bed", "--out", "report/REPORT.md"], dir);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let report = std::fs::read_to_string(dir.join("report/REPORT.md")).unwrap();
+    assert_eq!(report.lines().next(), Some("# X1 smoke"), "{report}");
+    assert_eq!(report.lines().last(), Some("verdict: pass"), "{report}");
+    assert!(report.contains("granflow run ") && report.contains("300 steps only"));
+
+    // The same results judged by a range the bed weight misses: the verdict names the failed check.
+    std::fs::write(dir.join("bed.yaml"), campaign("[100.0, 200.0]")).unwrap();
+    let out = granflow(&["run", "bed.yaml", "--out", "bed", "--quiet"], dir);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let out = granflow(&["report", "bed"], dir);
+    let report = String::from_utf8_lossy(&out.stdout);
+    assert_eq!(
+        report.lines().last(),
+        Some("verdict: fail (bed weight per area, rho = 2000)"),
+        "{report}"
+    );
+}
