@@ -8,6 +8,7 @@ use granflow::engine::Simulation;
 use granflow::engine::Vec3;
 use granflow::engine::gas::coupled::GasCoupling;
 use granflow::engine::gas::coupling::{PorosityMethod, gas_velocity_at};
+use granflow::engine::gas::fluid_forces::DragVelocities;
 use granflow::engine::gas::{Boundary, Convection, GasConfig, Grid};
 use granflow::engine::models::drag::{DragInput, DragLaw};
 
@@ -60,6 +61,7 @@ time: {{ dt_s: 1.0e-4, end_time_s: 2.0 }}
     let mut coupling = GasCoupling::new(
         gas,
         DragLaw::DiFelice,
+        DragVelocities::Instantaneous,
         PorosityMethod::VolumeSplit,
         0.3,
         20,
@@ -172,4 +174,57 @@ fn coupled_runs_are_bit_identical_on_one_and_two_threads() {
             .collect();
         assert_eq!(ua, ub);
     }
+}
+
+#[test]
+fn cell_averaged_drag_gives_the_gas_exactly_what_the_particles_get() {
+    // Seed 002's method 1 with several particles in the same and in neighbouring cells.
+    let sim = settling(1);
+    let mut fluid = sim.gas.as_ref().unwrap().fluid.clone();
+    fluid.drag_velocities = DragVelocities::CellAveraged;
+    fluid
+        .minus_pressure_gradient_pa_per_m
+        .iter_mut()
+        .for_each(|r| r.iter_mut().for_each(|v| *v = 0.0));
+    // A gas field with a shear, so the cell-centre velocities differ.
+    for a in 0..3 {
+        for (f, v) in fluid.velocity_m_per_s[a].iter_mut().enumerate() {
+            *v = 0.01 * (f % 7) as f64 - 0.02 * a as f64;
+        }
+    }
+    let positions: Vec<Vec3> = (0..9)
+        .map(|k| {
+            Vec3::new(
+                0.0005 + 0.0011 * k as f64,
+                0.004 + 0.0003 * (k % 3) as f64,
+                0.01 + 0.002 * (k % 4) as f64,
+            )
+        })
+        .collect();
+    let velocities: Vec<Vec3> = (0..9)
+        .map(|k| Vec3::new(0.1 * k as f64, -0.05, 0.02 * (k % 2) as f64))
+        .collect();
+    let radii = vec![RADIUS; 9];
+    let mut force = vec![Vec3::zeros(); 9];
+    fluid.add_forces(&positions, &velocities, &radii, &mut force);
+    let volume = fluid.grid.cell_volume_m3();
+    let total: Vec3 = force.iter().sum();
+    for a in 0..3 {
+        let given: f64 = fluid.reaction_n_per_m3[a].iter().sum::<f64>() * volume;
+        assert!(
+            (given + total[a]).abs() <= 1e-12 * total.norm(),
+            "axis {a}: {given} vs {}",
+            total[a]
+        );
+    }
+    // The drag of a particle does not depend on where in its cell it sits (particle 0 moved within its cell).
+    let mut shifted = positions.clone();
+    shifted[0].x += 0.0003;
+    let mut fluid2 = fluid.clone();
+    let mut force2 = vec![Vec3::zeros(); 9];
+    fluid2.add_forces(&shifted, &velocities, &radii, &mut force2);
+    assert_eq!(
+        force[0], force2[0],
+        "cell-averaged drag does not depend on the position inside the cell"
+    );
 }

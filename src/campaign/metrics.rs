@@ -94,6 +94,13 @@ pub const METRICS: &[MetricInfo] = &[
         needs_gas: false,
     },
     MetricInfo {
+        name: "coordination_number_time_avg",
+        unit: "1",
+        description: "mean particle-particle contacts per particle, averaged over the series from analysis.average_from_s (seed 002 Fig. 5's bulk coordination number)",
+        needs_mixing: false,
+        needs_gas: false,
+    },
+    MetricInfo {
         name: "bed_weight_per_area_pa",
         unit: "Pa",
         description: "weight of the particles over the inlet area, W/A (seed 000 eq. 2.74): what the pressure drop of a fluidized bed carries",

@@ -47,8 +47,10 @@ pub struct StageTimers {
     pub neighbor: Duration,
     pub force: Duration,
     pub integrate: Duration,
-    /// Gas steps (porosity, assembly, linear solves); the fluid forces on particles count under `force`.
+    /// Gas steps (porosity, assembly, linear solves).
     pub gas: Duration,
+    /// The gas's forces on the particles and their reaction (inside `force`).
+    pub fluid_forces: Duration,
 }
 
 pub struct Simulation {
@@ -323,7 +325,9 @@ impl Simulation {
                 self.accumulators_zeroed = true;
             }
             let p = &mut self.particles;
+            let t = Instant::now();
             fluid.add_forces(&p.position_m, &p.velocity_m_per_s, &p.radius_m, &mut p.force_n);
+            self.timers.fluid_forces += t.elapsed();
         }
         let kick = HalfKick {
             gravity: config.gravity.at(self.time_s),

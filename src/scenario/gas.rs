@@ -11,6 +11,7 @@ use super::ConfigError;
 use crate::engine::Vec3;
 use crate::engine::gas::coupled::GasCoupling;
 use crate::engine::gas::coupling::PorosityMethod;
+use crate::engine::gas::fluid_forces::DragVelocities;
 use crate::engine::gas::grid::side;
 use crate::engine::gas::simple::InletFace;
 use crate::engine::gas::{Boundary, Convection, GasConfig, Grid};
@@ -31,6 +32,10 @@ pub struct GasSpec {
     pub jets: Vec<JetSpec>,
     #[serde(default = "default_drag")]
     pub drag: DragLaw,
+    /// Which velocities drag is computed from: `instantaneous` (each particle's own, gas interpolated to it) or
+    /// `cell_averaged` (seed 002's method 1: the cell's mean particle velocity and centre gas velocity).
+    #[serde(default)]
+    pub drag_velocities: DragVelocities,
     /// How particle volume becomes cell porosity (default `volume_split`).
     #[serde(default)]
     pub porosity: PorosityMethod,
@@ -179,6 +184,7 @@ impl Default for GasSolverSpec {
 pub struct GasSetup {
     pub config: GasConfig,
     pub drag: DragLaw,
+    pub drag_velocities: DragVelocities,
     pub porosity_method: PorosityMethod,
     pub min_porosity: f64,
     pub dem_steps_per_gas_step: u64,
@@ -191,6 +197,7 @@ impl GasSetup {
         GasCoupling::new(
             self.config.clone(),
             self.drag,
+            self.drag_velocities,
             self.porosity_method,
             self.min_porosity,
             self.dem_steps_per_gas_step,
@@ -423,6 +430,7 @@ pub fn build_gas(
     Ok(GasSetup {
         config,
         drag: spec.drag,
+        drag_velocities: spec.drag_velocities,
         porosity_method: spec.porosity,
         min_porosity: spec.min_porosity,
         dem_steps_per_gas_step: spec.dem_steps_per_gas_step,

@@ -129,6 +129,8 @@ impl Series {
             "m"
         } else if name.ends_with("_s") {
             "s"
+        } else if name.ends_with("_pa") {
+            "Pa"
         } else if name == "step" || name.ends_with("contacts") {
             "count"
         } else {
@@ -177,6 +179,9 @@ pub fn metrics(job: &JobSpec, built: &BuiltScenario, sim: &Simulation, series: &
                 .map_or(f64::NAN, |t| t),
             "mean_height_time_avg_m" => window(series, "mean_height_m", average_from_s).map_or(f64::NAN, |w| mean(&w)),
             "bed_weight_per_area_pa" => bed_weight_per_area_pa(built, sim),
+            "coordination_number_time_avg" => {
+                window(series, "mean_coordination", average_from_s).map_or(f64::NAN, |w| mean(&w))
+            }
             "pressure_drop_mean_pa" => {
                 window(series, "column_pressure_drop_pa", average_from_s).map_or(f64::NAN, |w| mean(&w))
             }

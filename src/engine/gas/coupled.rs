@@ -8,7 +8,7 @@
 //! `dem_steps_per_gas_step`-th step; its state ([`GasSnapshot`]) is part of the checkpoint.
 
 use super::coupling::{PorosityMethod, porosity};
-use super::fluid_forces::FluidForces;
+use super::fluid_forces::{DragVelocities, FluidForces};
 use super::grid::{Boundary, side};
 use super::simple::{GasConfig, GasSolver};
 use crate::engine::Vec3;
@@ -47,6 +47,8 @@ pub struct GasCoupling {
     /// gradient that carries the particles' weight, without which the mixture would accelerate for ever).
     pub gas_body_force_n_per_m3: [f64; 3],
     pub last: GasStepStats,
+    /// Wall time spent in the gas's linear solvers (not checkpointed; for profiles), s.
+    pub linear_solve_s: f64,
 }
 
 impl GasCoupling {
@@ -55,6 +57,7 @@ impl GasCoupling {
     pub fn new(
         gas_config: GasConfig,
         drag: DragLaw,
+        drag_velocities: DragVelocities,
         porosity_method: PorosityMethod,
         min_porosity: f64,
         dem_steps_per_gas_step: u64,
@@ -73,6 +76,7 @@ impl GasCoupling {
             solver.config.density_kg_per_m3,
             solver.config.viscosity_pa_s,
         );
+        fluid.drag_velocities = drag_velocities;
         fluid.freeze(
             &solver.interstitial_velocity_m_per_s(),
             &solver.state.pressure_pa,
@@ -86,6 +90,7 @@ impl GasCoupling {
             dem_steps_per_gas_step,
             gas_body_force_n_per_m3: [0.0; 3],
             last: GasStepStats::default(),
+            linear_solve_s: 0.0,
         })
     }
 
@@ -101,6 +106,7 @@ impl GasCoupling {
             s.iter_mut().for_each(|v| *v += self.gas_body_force_n_per_m3[a]);
         }
         let report = self.solver.step(dt_s, &source, &Default::default(), &old_porosity);
+        self.linear_solve_s += report.linear_solve_s;
         let state = &self.solver.state;
         if let Some(k) = state.pressure_pa.iter().position(|p| !p.is_finite()) {
             return Err(format!("gas pressure of cell {k} is not finite"));

@@ -9,16 +9,30 @@
 
 use std::f64::consts::PI;
 
+use serde::{Deserialize, Serialize};
+
 use super::coupling::interpolate_component;
 use super::grid::Grid;
 use crate::engine::Vec3;
 use crate::engine::models::drag::{DragInput, DragLaw};
+
+/// Which velocities the drag on a particle is computed from (seed 002 §3.3).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize, schemars::JsonSchema)]
+#[serde(rename_all = "snake_case")]
+pub enum DragVelocities {
+    /// The particle's own velocity and the gas velocity interpolated to it (seed 002 method 2).
+    #[default]
+    Instantaneous,
+    /// The cell's mean particle velocity and the gas velocity at the cell centre (seed 002 method 1).
+    CellAveraged,
+}
 
 /// A frozen gas field and the reaction accumulated since it was frozen.
 #[derive(Debug, Clone)]
 pub struct FluidForces {
     pub grid: Grid,
     pub drag: DragLaw,
+    pub drag_velocities: DragVelocities,
     pub gas_density_kg_per_m3: f64,
     pub gas_viscosity_pa_s: f64,
     /// Gas velocity on faces (copied from the gas solver).
@@ -42,6 +56,7 @@ impl FluidForces {
             steps: 0,
             grid,
             drag,
+            drag_velocities: DragVelocities::Instantaneous,
             gas_density_kg_per_m3,
             gas_viscosity_pa_s,
         }
@@ -131,8 +146,116 @@ impl FluidForces {
         }
     }
 
+    /// The cell holding `x` (clamped into a non-periodic grid, wrapped on a periodic axis).
+    fn cell_of(&self, x: &Vec3) -> [usize; 3] {
+        let grid = &self.grid;
+        std::array::from_fn(|a| {
+            let c = ((x[a] - grid.origin_m[a]) / grid.h_m[a]).floor() as isize;
+            let n = grid.n[a] as isize;
+            if grid.periodic(a) {
+                c.rem_euclid(n) as usize
+            } else {
+                c.clamp(0, n - 1) as usize
+            }
+        })
+    }
+
+    /// The faces bounding cell `c` along `axis` (low, high), moved inwards off a non-periodic boundary.
+    fn cell_faces(&self, c: [usize; 3], axis: usize) -> [usize; 2] {
+        let grid = &self.grid;
+        let mut lo = c;
+        let mut hi = c;
+        hi[axis] += 1;
+        if grid.periodic(axis) {
+            hi[axis] %= grid.n[axis];
+        } else if grid.n[axis] > 1 {
+            lo[axis] = lo[axis].clamp(1, grid.n[axis] - 1);
+            hi[axis] = hi[axis].clamp(1, grid.n[axis] - 1);
+        }
+        [grid.face(axis, lo), grid.face(axis, hi)]
+    }
+
+    /// The gas velocity at the centre of cell `c`: the mean of its two faces along each axis.
+    fn cell_gas_velocity(&self, c: [usize; 3]) -> Vec3 {
+        let grid = &self.grid;
+        let mut u = Vec3::zeros();
+        for a in 0..grid.axes() {
+            let mut hi = c;
+            hi[a] += 1;
+            if grid.periodic(a) {
+                hi[a] %= grid.n[a];
+            }
+            let v = &self.velocity_m_per_s[a];
+            u[a] = 0.5 * (v[grid.face(a, c)] + v[grid.face(a, hi)]);
+        }
+        u
+    }
+
     /// Adds the gas's force on each particle to `force` and accumulates the reaction on the gas for one DEM step.
     pub fn add_forces(
+        &mut self,
+        positions_m: &[Vec3],
+        velocities_m_per_s: &[Vec3],
+        radii_m: &[f64],
+        force: &mut [Vec3],
+    ) {
+        match self.drag_velocities {
+            DragVelocities::Instantaneous => {
+                self.add_forces_instantaneous(positions_m, velocities_m_per_s, radii_m, force)
+            }
+            DragVelocities::CellAveraged => {
+                self.add_forces_cell_averaged(positions_m, velocities_m_per_s, radii_m, force)
+            }
+        }
+        self.steps += 1;
+    }
+
+    fn add_forces_cell_averaged(
+        &mut self,
+        positions_m: &[Vec3],
+        velocities_m_per_s: &[Vec3],
+        radii_m: &[f64],
+        force: &mut [Vec3],
+    ) {
+        let grid = self.grid.clone();
+        let cell_volume = grid.cell_volume_m3();
+        let cells: Vec<usize> = positions_m.iter().map(|x| grid.cell(self.cell_of(x))).collect();
+        // Volume-weighted mean particle velocity per cell (seed 002 eq 35).
+        let mut volume = vec![0.0; grid.cells()];
+        let mut momentum = vec![Vec3::zeros(); grid.cells()];
+        for i in 0..positions_m.len() {
+            let v = 4.0 / 3.0 * PI * radii_m[i].powi(3);
+            volume[cells[i]] += v;
+            momentum[cells[i]] += velocities_m_per_s[i] * v;
+        }
+        for i in 0..positions_m.len() {
+            let x = &positions_m[i];
+            let c = self.cell_of(x);
+            let k_cell = cells[i];
+            let v_sm = momentum[k_cell] / volume[k_cell];
+            let slip = self.cell_gas_velocity(c) - v_sm;
+            let k = self.drag.coefficient_n_s_per_m(&DragInput {
+                porosity: self.porosity[k_cell],
+                slip_speed_m_per_s: slip.norm(),
+                diameter_m: 2.0 * radii_m[i],
+                gas_density_kg_per_m3: self.gas_density_kg_per_m3,
+                gas_viscosity_pa_s: self.gas_viscosity_pa_s,
+            });
+            let drag = slip * k;
+            let mut grad = Vec3::zeros();
+            for a in 0..grid.axes() {
+                grad[a] = interpolate_component(&grid, &self.minus_pressure_gradient_pa_per_m[a], a, x);
+            }
+            force[i] += drag + grad * (4.0 / 3.0 * PI * radii_m[i].powi(3));
+            for a in 0..grid.axes() {
+                for face in self.cell_faces(c, a) {
+                    self.reaction_n_per_m3[a][face] -= 0.5 * drag[a] / cell_volume;
+                }
+            }
+        }
+    }
+
+    fn add_forces_instantaneous(
         &mut self,
         positions_m: &[Vec3],
         velocities_m_per_s: &[Vec3],
@@ -146,15 +269,7 @@ impl FluidForces {
             let x = &positions_m[i];
             let r = radii_m[i];
             let volume = 4.0 / 3.0 * PI * r * r * r;
-            let cell: [usize; 3] = std::array::from_fn(|a| {
-                let c = ((x[a] - grid.origin_m[a]) / grid.h_m[a]).floor() as isize;
-                let n = grid.n[a] as isize;
-                if grid.periodic(a) {
-                    c.rem_euclid(n) as usize
-                } else {
-                    c.clamp(0, n - 1) as usize
-                }
-            });
+            let cell = self.cell_of(x);
             let eps = self.porosity[grid.cell(cell)];
             let mut u = Vec3::zeros();
             let mut grad = Vec3::zeros();
@@ -179,7 +294,6 @@ impl FluidForces {
                 }
             }
         }
-        self.steps += 1;
     }
 
     /// The mean reaction per unit volume over the DEM steps since the last freeze (the gas's momentum source).

@@ -82,6 +82,8 @@ pub struct StepReport {
     pub converged: bool,
     pub momentum: SolveReport,
     pub pressure: SolveReport,
+    /// Wall time in the linear solvers (the rest of the step is assembly and corrections), s.
+    pub linear_solve_s: f64,
 }
 
 impl GasState {
@@ -516,6 +518,7 @@ impl GasSolver {
                 relative_residual: 0.0,
                 converged: true,
             },
+            linear_solve_s: 0.0,
         };
         for outer in 0..self.config.max_outer_iterations {
             let before = self.state.velocity_m_per_s.clone();
@@ -525,12 +528,14 @@ impl GasSolver {
                     .iter()
                     .map(|&f| self.state.velocity_m_per_s[c][f])
                     .collect();
+                let t = std::time::Instant::now();
                 let r = bicgstab(
                     &sys,
                     &mut x,
                     self.config.linear_tolerance,
                     self.config.max_linear_iterations,
                 );
+                report.linear_solve_s += t.elapsed().as_secs_f64();
                 report.momentum.iterations += r.iterations;
                 report.momentum.relative_residual = report.momentum.relative_residual.max(r.relative_residual);
                 report.momentum.converged &= r.converged;
@@ -559,6 +564,7 @@ impl GasSolver {
                 break;
             }
             let mut pc = vec![0.0; psys.len()];
+            let t = std::time::Instant::now();
             let r = conjugate_gradient(
                 &psys,
                 &mut pc,
@@ -566,6 +572,7 @@ impl GasSolver {
                 self.config.max_linear_iterations,
                 true,
             );
+            report.linear_solve_s += t.elapsed().as_secs_f64();
             report.pressure.iterations += r.iterations;
             report.pressure.relative_residual = report.pressure.relative_residual.max(r.relative_residual);
             report.pressure.converged &= r.converged;
