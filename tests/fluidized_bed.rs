@@ -149,6 +149,18 @@ fn bad_gas_input_is_rejected_with_its_key_before_anything_is_written() {
         );
         assert!(!dir.join(format!("out{k}")).exists(), "case {k}: wrote output");
     }
+    // A blocked box holding no cell centre.
+    let text = bed(
+        0.01,
+        "  blocked: [ { lo_m: [0.0, 0.0501, 0.0], hi_m: [0.03, 0.0502, 0.0027] } ]",
+    );
+    std::fs::write(dir.join("blocked.yaml"), text).unwrap();
+    let out = granflow(&["simulate", "blocked.yaml", "--out", "blocked", "--quiet"], dir);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        err.contains("gas.blocked[0]") && err.contains("no cell centre"),
+        "{err}"
+    );
     // A jet box holding no face of its side.
     let text = bed(
         0.01,

@@ -18,6 +18,7 @@ fn config(grid: Grid, density: f64, viscosity: f64, convection: Convection) -> G
         linear_tolerance: 1e-10,
         max_linear_iterations: 2000,
         inlet_faces: Vec::new(),
+        blocked: Vec::new(),
     }
 }
 
@@ -355,4 +356,68 @@ fn c4_advection_diffusion_matches_the_exponential_profile() {
         .fold(0.0, f64::max);
     eprintln!("C4 advection-diffusion: max error {:.4} % of the range", 100.0 * worst);
     assert!(worst < 0.01, "max error {worst}");
+}
+
+/// C1 again with the channel walls made of blocked cells inside a grid periodic in both directions: two blocked
+/// rows below and two above the channel. The profile must be the same parabola, with the walls at the blocked
+/// cells' faces — the no-slip treatment of blocked cells (the kiln's geometry later) checked against the analytic
+/// solution.
+#[test]
+fn c1_poiseuille_between_blocked_cells() {
+    let (h, mu, rho, g) = (0.01, 1.8e-5, 1.2, 0.5);
+    let ny = 20;
+    let dy = h / ny as f64;
+    let rows = ny + 4;
+    let grid = Grid {
+        n: [8, rows, 1],
+        h_m: [0.002, dy, 0.002],
+        origin_m: [0.0; 3],
+        boundary: [
+            Boundary::Periodic,
+            Boundary::Periodic,
+            Boundary::Periodic,
+            Boundary::Periodic,
+            WALL,
+            WALL,
+        ],
+    };
+    let mut cfg = config(grid.clone(), rho, mu, Convection::Hybrid);
+    cfg.blocked = (0..grid.cells())
+        .map(|c| {
+            let j = (c / grid.n[0]) % rows;
+            j < 2 || j >= ny + 2
+        })
+        .collect();
+    let mut solver = GasSolver::new(cfg).unwrap();
+    let source = [vec![g; grid.faces(0)], vec![0.0; grid.faces(1)], vec![]];
+    let eps = solver.state.porosity.clone();
+    for _ in 0..40 {
+        solver.step(20.0, &source, &Default::default(), &eps);
+    }
+    let u_max = g * h * h / (8.0 * mu);
+    let mut worst: f64 = 0.0;
+    for j in 2..ny + 2 {
+        let y = (j as f64 - 2.0 + 0.5) * dy;
+        let exact = g * y * (h - y) / (2.0 * mu);
+        for i in 0..grid.n[0] {
+            let u = solver.state.velocity_m_per_s[0][grid.face(0, [i, j, 0])];
+            worst = worst.max((u - exact).abs() / u_max);
+        }
+    }
+    // Nothing moves inside the blocked rows, and no gas crosses into them.
+    for j in (0..2).chain(ny + 2..rows) {
+        for i in 0..grid.n[0] {
+            assert_eq!(solver.state.velocity_m_per_s[0][grid.face(0, [i, j, 0])], 0.0);
+        }
+    }
+    for i in 0..grid.n[0] {
+        for j in [2, ny + 2] {
+            assert_eq!(solver.state.velocity_m_per_s[1][grid.face(1, [i, j, 0])], 0.0);
+        }
+    }
+    eprintln!(
+        "C1 with blocked walls: max error {:.3} % of the centreline velocity",
+        100.0 * worst
+    );
+    assert!(worst < 0.01, "max error {:.3} %", 100.0 * worst);
 }

@@ -30,6 +30,10 @@ pub struct GasSpec {
     /// Jets: boundary faces whose centres lie in a box get their own inflow velocity (seed 002's central jet).
     #[serde(default)]
     pub jets: Vec<JetSpec>,
+    /// Blocked cells: those whose centres lie in any of these boxes are outside the gas (no-slip walls around
+    /// them). Particles need their own walls there.
+    #[serde(default)]
+    pub blocked: Vec<BoxSpec>,
     #[serde(default = "default_drag")]
     pub drag: DragLaw,
     /// Which velocities drag is computed from: `instantaneous` (each particle's own, gas interpolated to it) or
@@ -122,6 +126,13 @@ pub struct JetSpec {
     pub hi_m: [f64; 3],
     /// Inflow velocity into the domain, m/s.
     pub superficial_velocity_m_per_s: f64,
+}
+
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, schemars::JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct BoxSpec {
+    pub lo_m: [f64; 3],
+    pub hi_m: [f64; 3],
 }
 
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize, schemars::JsonSchema)]
@@ -411,6 +422,32 @@ pub fn build_gas(
             ));
         }
     }
+    let mut blocked = Vec::new();
+    if !spec.blocked.is_empty() {
+        blocked = vec![false; grid.cells()];
+        for (k, b) in spec.blocked.iter().enumerate() {
+            let before = blocked.iter().filter(|&&x| x).count();
+            for kk in 0..grid.n[2] {
+                for j in 0..grid.n[1] {
+                    for i in 0..grid.n[0] {
+                        let c = grid.cell_centre_m([i, j, kk]);
+                        if (0..3).all(|a| c[a] >= b.lo_m[a] && c[a] <= b.hi_m[a]) {
+                            blocked[grid.cell([i, j, kk])] = true;
+                        }
+                    }
+                }
+            }
+            if blocked.iter().filter(|&&x| x).count() == before {
+                return Err(fail(
+                    format!("gas.blocked[{k}]"),
+                    "the box holds no cell centre that is not already blocked".into(),
+                ));
+            }
+        }
+        if blocked.iter().all(|&x| x) {
+            return Err(fail("gas.blocked".into(), "every gas cell is blocked".into()));
+        }
+    }
     let config = GasConfig {
         grid,
         density_kg_per_m3: spec.density_kg_per_m3,
@@ -425,8 +462,10 @@ pub fn build_gas(
         linear_tolerance: s.linear_tolerance,
         max_linear_iterations: s.max_linear_iterations,
         inlet_faces,
+        blocked,
     };
     config.grid.check().map_err(|m| fail("gas.cells".into(), m))?;
+    crate::engine::gas::GasSolver::new(config.clone()).map_err(|m| fail("gas".into(), m))?;
     Ok(GasSetup {
         config,
         drag: spec.drag,

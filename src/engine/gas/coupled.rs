@@ -194,7 +194,8 @@ impl GasCoupling {
             for j in 0..grid.n[1] {
                 for i in 0..grid.n[0] {
                     let idx = [i, j, k];
-                    if idx[axis] == layer {
+                    let blocked = &self.solver.config.blocked;
+                    if idx[axis] == layer && (blocked.is_empty() || !blocked[grid.cell(idx)]) {
                         sum += p[grid.cell(idx)];
                         count += 1;
                     }

@@ -47,6 +47,9 @@ pub struct GasConfig {
     /// Boundary faces through which gas enters at their own velocity (jets through chosen distributor cells),
     /// overriding what their side says.
     pub inlet_faces: Vec<InletFace>,
+    /// Cells outside the gas domain (solid: a kiln wall's outside), one flag per cell, or empty for none. Their
+    /// faces are no-slip walls at rest; the design leaves room for moving them (a wall velocity per face).
+    pub blocked: Vec<bool>,
 }
 
 /// One boundary face with a prescribed normal velocity.
@@ -143,6 +146,13 @@ impl GasSolver {
     pub fn new(config: GasConfig) -> Result<Self, String> {
         config.grid.check()?;
         let grid = &config.grid;
+        if !config.blocked.is_empty() && config.blocked.len() != grid.cells() {
+            return Err(format!(
+                "blocked cells: expected one flag per cell ({}), got {}",
+                grid.cells(),
+                config.blocked.len()
+            ));
+        }
         let mut unknown: [Vec<u32>; 3] = std::array::from_fn(|a| vec![NONE; grid.faces(a)]);
         let mut face_of: [Vec<usize>; 3] = Default::default();
         for a in 0..grid.axes() {
@@ -152,7 +162,7 @@ impl GasSolver {
                     along < grid.n[a]
                 } else {
                     along > 0 && along < grid.n[a]
-                };
+                } && !face_touches_blocked(grid, &config.blocked, a, idx);
                 if solved {
                     let f = grid.face(a, idx);
                     unknown[a][f] = face_of[a].len() as u32;
@@ -165,7 +175,10 @@ impl GasSolver {
         for a in 0..grid.axes() {
             for idx in all_indices(grid.face_dims(a)) {
                 let along = idx[a];
-                if !grid.periodic(a) && (along == 0 || along == grid.n[a]) {
+                if !grid.periodic(a)
+                    && (along == 0 || along == grid.n[a])
+                    && !face_touches_blocked(grid, &config.blocked, a, idx)
+                {
                     let b = grid.boundary[side(a, along == grid.n[a])];
                     plenum[a][grid.face(a, idx)] = matches!(b, Boundary::Inlet { .. });
                 }
@@ -226,6 +239,16 @@ impl GasSolver {
         for f in &self.config.inlet_faces {
             self.state.velocity_m_per_s[f.axis][f.face] = f.velocity_m_per_s;
         }
+        if !self.config.blocked.is_empty() {
+            let grid = &self.config.grid;
+            for a in 0..grid.axes() {
+                for idx in all_indices(grid.face_dims(a)) {
+                    if face_touches_blocked(grid, &self.config.blocked, a, idx) {
+                        self.state.velocity_m_per_s[a][grid.face(a, idx)] = 0.0;
+                    }
+                }
+            }
+        }
     }
 
     /// Scales the outlet faces' velocities so that outflow = inflow through the other boundary faces minus the gas
@@ -248,6 +271,9 @@ impl GasSolver {
                 let f = grid.face(a, idx);
                 let inward = if along == 0 { 1.0 } else { -1.0 };
                 let flux = rho * self.porosity_at_face(a, idx) * self.state.velocity_m_per_s[a][f] * area;
+                if face_touches_blocked(grid, &self.config.blocked, a, idx) {
+                    continue;
+                }
                 if matches!(grid.boundary[side(a, along != 0)], Boundary::Outlet) {
                     outflow -= inward * flux;
                     outlet_faces.push((a, f, inward));
@@ -389,7 +415,8 @@ impl GasSolver {
                     let neighbour_hi = step_cell(grid, cell_hi, dax, delta);
                     let neighbour_lo = step_cell(grid, cell_lo, dax, delta);
                     let sign = if high { 1.0 } else { -1.0 };
-                    match (neighbour_lo, neighbour_hi) {
+                    let open = |c: Option<[usize; 3]>| c.filter(|c| !cell_blocked(grid, &cfg.blocked, *c));
+                    match (open(neighbour_lo), open(neighbour_hi)) {
                         (Some(nl), Some(nh)) => {
                             let eps_corner = 0.25 * (eps_lo + eps_hi + eps[grid.cell(nl)] + eps[grid.cell(nh)]);
                             let flux = rho * eps_corner * v_flux * area_d;
@@ -406,9 +433,15 @@ impl GasSolver {
                             net_out += sign * flux;
                         }
                         _ => {
-                            // A wall or inlet along d: the ghost value is the side's tangential velocity, half a
-                            // cell away.
-                            let boundary = grid.boundary[side(dax, high)];
+                            // A wall or inlet along d (or blocked cells: a wall at rest): the ghost value is the
+                            // side's tangential velocity, half a cell away.
+                            let boundary = if neighbour_lo.is_some() && neighbour_hi.is_some() {
+                                Boundary::Wall {
+                                    velocity_m_per_s: [0.0; 3],
+                                }
+                            } else {
+                                grid.boundary[side(dax, high)]
+                            };
                             let flux = rho * eps_f * v_flux * area_d;
                             let diff = mu * eps_f * area_d / (0.5 * grid.h_m[dax]);
                             add(
@@ -483,6 +516,12 @@ impl GasSolver {
                         slot += 1;
                     }
                 }
+            }
+            if cell_blocked(grid, &self.config.blocked, idx) {
+                // Outside the gas: p' = 0.
+                sys.ap[pcell] = 1.0;
+                sys.b[pcell] = 0.0;
+                continue;
             }
             let accumulation = rho * grid.cell_volume_m3() * (eps[pcell] - old_porosity[pcell]) / dt_s;
             sys.b[pcell] = -(net_out + accumulation);
@@ -628,7 +667,8 @@ impl GasSolver {
                     continue;
                 }
                 for idx in all_indices(grid.n) {
-                    if idx[a] == if high { grid.n[a] - 1 } else { 0 } {
+                    if idx[a] == if high { grid.n[a] - 1 } else { 0 } && !cell_blocked(grid, &self.config.blocked, idx)
+                    {
                         sum += self.state.pressure_pa[grid.cell(idx)];
                         count += 1;
                     }
@@ -640,6 +680,39 @@ impl GasSolver {
             self.state.pressure_pa.iter_mut().for_each(|p| *p -= shift);
         }
     }
+}
+
+/// Whether cell `c` is blocked.
+fn cell_blocked(grid: &Grid, blocked: &[bool], c: [usize; 3]) -> bool {
+    !blocked.is_empty() && blocked[grid.cell(c)]
+}
+
+/// Whether face `idx` of the component along `axis` has a blocked cell on either side.
+fn face_touches_blocked(grid: &Grid, blocked: &[bool], axis: usize, idx: [usize; 3]) -> bool {
+    if blocked.is_empty() {
+        return false;
+    }
+    let n = grid.n[axis];
+    let mut hi = idx;
+    let mut lo = idx;
+    let hi_ok = if idx[axis] < n {
+        true
+    } else if grid.periodic(axis) {
+        hi[axis] = 0;
+        true
+    } else {
+        false
+    };
+    let lo_ok = if idx[axis] > 0 {
+        lo[axis] -= 1;
+        true
+    } else if grid.periodic(axis) {
+        lo[axis] = n - 1;
+        true
+    } else {
+        false
+    };
+    (hi_ok && blocked[grid.cell(hi)]) || (lo_ok && blocked[grid.cell(lo)])
 }
 
 /// The (i, j, k) of face `f` of the component along `axis`.
