@@ -192,3 +192,29 @@ fn a_jet_carries_its_own_inflow() {
     let bottom = &gas.velocity_m_per_s[1][..4];
     assert_eq!(bottom, &[2.5, 10.0, 10.0, 2.5], "inlet faces: {bottom:?}");
 }
+
+#[test]
+fn a_three_dimensional_bed_runs_with_a_three_dimensional_gas() {
+    let tmp = tempfile::tempdir().expect("temp dir");
+    let dir = tmp.path();
+    // Two particle layers deep in z with walls front and back, 4 x 12 x 2 gas cells.
+    let text = bed(0.01, "")
+        .replace("hi_m: [0.03, 0.1, 0.0027]", "hi_m: [0.03, 0.1, 0.0066]")
+        .replace("pseudo_2d: true", "pseudo_2d: false")
+        .replace("hi_m: [0.03, 0.0315, 0.0027]", "hi_m: [0.03, 0.0315, 0.0066]")
+        .replace("cells: [4, 12, 1]", "cells: [4, 12, 2]");
+    assert!(text.contains("cells: [4, 12, 2]") && text.contains("0.0066"));
+    std::fs::write(dir.join("bed3d.yaml"), text).unwrap();
+    run_ok(&["simulate", "bed3d.yaml", "--out", "bed3d", "--quiet", "--threads", "2"], dir);
+    let state = final_state(&dir.join("bed3d"));
+    assert_eq!(state.particles.len(), 200);
+    let gas = state.gas.expect("gas");
+    assert_eq!(gas.pressure_pa.len(), 4 * 12 * 2);
+    assert!(gas.velocity_m_per_s[2].iter().all(|w| w.is_finite()));
+    assert!(gas.velocity_m_per_s[2].iter().any(|w| w.abs() > 1e-9), "the z velocity is solved in 3-D");
+    let series = std::fs::read_to_string(dir.join("bed3d/series.csv")).unwrap();
+    let header: Vec<&str> = series.lines().next().unwrap().split(',').collect();
+    let k = header.iter().position(|h| *h == "column_pressure_drop_pa").unwrap();
+    let dp: f64 = series.lines().last().unwrap().split(',').nth(k).unwrap().parse().unwrap();
+    assert!(dp > 100.0, "pressure drop across the 3-D bed: {dp}");
+}
