@@ -205,16 +205,50 @@ fn a_three_dimensional_bed_runs_with_a_three_dimensional_gas() {
         .replace("cells: [4, 12, 1]", "cells: [4, 12, 2]");
     assert!(text.contains("cells: [4, 12, 2]") && text.contains("0.0066"));
     std::fs::write(dir.join("bed3d.yaml"), text).unwrap();
-    run_ok(&["simulate", "bed3d.yaml", "--out", "bed3d", "--quiet", "--threads", "2"], dir);
+    run_ok(
+        &["simulate", "bed3d.yaml", "--out", "bed3d", "--quiet", "--threads", "2"],
+        dir,
+    );
     let state = final_state(&dir.join("bed3d"));
     assert_eq!(state.particles.len(), 200);
     let gas = state.gas.expect("gas");
     assert_eq!(gas.pressure_pa.len(), 4 * 12 * 2);
     assert!(gas.velocity_m_per_s[2].iter().all(|w| w.is_finite()));
-    assert!(gas.velocity_m_per_s[2].iter().any(|w| w.abs() > 1e-9), "the z velocity is solved in 3-D");
+    assert!(
+        gas.velocity_m_per_s[2].iter().any(|w| w.abs() > 1e-9),
+        "the z velocity is solved in 3-D"
+    );
     let series = std::fs::read_to_string(dir.join("bed3d/series.csv")).unwrap();
     let header: Vec<&str> = series.lines().next().unwrap().split(',').collect();
     let k = header.iter().position(|h| *h == "column_pressure_drop_pa").unwrap();
-    let dp: f64 = series.lines().last().unwrap().split(',').nth(k).unwrap().parse().unwrap();
+    let dp: f64 = series
+        .lines()
+        .last()
+        .unwrap()
+        .split(',')
+        .nth(k)
+        .unwrap()
+        .parse()
+        .unwrap();
     assert!(dp > 100.0, "pressure drop across the 3-D bed: {dp}");
+}
+
+#[test]
+fn cell_averaged_drag_gives_the_same_bits_on_one_and_two_threads() {
+    let tmp = tempfile::tempdir().expect("temp dir");
+    let dir = tmp.path();
+    std::fs::write(dir.join("bed.yaml"), bed(0.01, "  drag_velocities: cell_averaged")).unwrap();
+    run_ok(
+        &["simulate", "bed.yaml", "--out", "one", "--quiet", "--threads", "1"],
+        dir,
+    );
+    run_ok(
+        &["simulate", "bed.yaml", "--out", "two", "--quiet", "--threads", "2"],
+        dir,
+    );
+    let (one, two) = (final_state(&dir.join("one")), final_state(&dir.join("two")));
+    assert_eq!(one.step, 1000);
+    if let Some(diff) = first_difference(&one, &two) {
+        panic!("1 and 2 threads differ: {diff}");
+    }
 }

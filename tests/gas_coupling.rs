@@ -138,7 +138,7 @@ fn the_gas_receives_exactly_the_momentum_the_particle_loses_to_drag() {
         .for_each(|r| r.iter_mut().for_each(|v| *v = 0.0));
     let p = &sim.particles;
     let mut force = vec![Vec3::zeros(); 1];
-    fluid.add_forces(&p.position_m, &p.velocity_m_per_s, &p.radius_m, &mut force);
+    fluid.add_forces(&p.position_m, &p.velocity_m_per_s, &p.radius_m, &mut force, None);
     let volume = fluid.grid.cell_volume_m3();
     for a in 0..3 {
         let given: f64 = fluid.reaction_n_per_m3[a].iter().sum::<f64>() * volume;
@@ -207,7 +207,7 @@ fn cell_averaged_drag_gives_the_gas_exactly_what_the_particles_get() {
         .collect();
     let radii = vec![RADIUS; 9];
     let mut force = vec![Vec3::zeros(); 9];
-    fluid.add_forces(&positions, &velocities, &radii, &mut force);
+    fluid.add_forces(&positions, &velocities, &radii, &mut force, None);
     let volume = fluid.grid.cell_volume_m3();
     let total: Vec3 = force.iter().sum();
     for a in 0..3 {
@@ -223,7 +223,7 @@ fn cell_averaged_drag_gives_the_gas_exactly_what_the_particles_get() {
     shifted[0].x += 0.0003;
     let mut fluid2 = fluid.clone();
     let mut force2 = vec![Vec3::zeros(); 9];
-    fluid2.add_forces(&shifted, &velocities, &radii, &mut force2);
+    fluid2.add_forces(&shifted, &velocities, &radii, &mut force2, None);
     assert_eq!(
         force[0], force2[0],
         "cell-averaged drag does not depend on the position inside the cell"

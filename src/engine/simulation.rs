@@ -326,7 +326,8 @@ impl Simulation {
             }
             let p = &mut self.particles;
             let t = Instant::now();
-            fluid.add_forces(&p.position_m, &p.velocity_m_per_s, &p.radius_m, &mut p.force_n);
+            let pool = (self.team.size() > 1).then_some(&*self.pool);
+            fluid.add_forces(&p.position_m, &p.velocity_m_per_s, &p.radius_m, &mut p.force_n, pool);
             self.timers.fluid_forces += t.elapsed();
         }
         let kick = HalfKick {

@@ -43,6 +43,8 @@ pub struct FluidForces {
     /// Σ over DEM steps of the force on the gas per unit volume at each face, N/m³ (divide by `steps`).
     pub reaction_n_per_m3: [Vec<f64>; 3],
     pub steps: u32,
+    /// Workspace: each particle's drag of the current step.
+    drag_buffer: Vec<Vec3>,
 }
 
 impl FluidForces {
@@ -54,6 +56,7 @@ impl FluidForces {
             reaction_n_per_m3: zeros(&grid),
             porosity: vec![1.0; grid.cells()],
             steps: 0,
+            drag_buffer: Vec::new(),
             grid,
             drag,
             drag_velocities: DragVelocities::Instantaneous,
@@ -192,19 +195,21 @@ impl FluidForces {
     }
 
     /// Adds the gas's force on each particle to `force` and accumulates the reaction on the gas for one DEM step.
+    /// With a pool, the per-particle forces of the instantaneous method are computed on it (same bits).
     pub fn add_forces(
         &mut self,
         positions_m: &[Vec3],
         velocities_m_per_s: &[Vec3],
         radii_m: &[f64],
         force: &mut [Vec3],
+        pool: Option<&rayon::ThreadPool>,
     ) {
         match self.drag_velocities {
             DragVelocities::Instantaneous => {
-                self.add_forces_instantaneous(positions_m, velocities_m_per_s, radii_m, force)
+                self.add_forces_instantaneous(positions_m, velocities_m_per_s, radii_m, force, pool)
             }
             DragVelocities::CellAveraged => {
-                self.add_forces_cell_averaged(positions_m, velocities_m_per_s, radii_m, force)
+                self.add_forces_cell_averaged(positions_m, velocities_m_per_s, radii_m, force, pool)
             }
         }
         self.steps += 1;
@@ -216,11 +221,11 @@ impl FluidForces {
         velocities_m_per_s: &[Vec3],
         radii_m: &[f64],
         force: &mut [Vec3],
+        pool: Option<&rayon::ThreadPool>,
     ) {
         let grid = self.grid.clone();
-        let cell_volume = grid.cell_volume_m3();
         let cells: Vec<usize> = positions_m.iter().map(|x| grid.cell(self.cell_of(x))).collect();
-        // Volume-weighted mean particle velocity per cell (seed 002 eq 35).
+        // Volume-weighted mean particle velocity per cell (seed 002 eq 35), serially in particle order.
         let mut volume = vec![0.0; grid.cells()];
         let mut momentum = vec![Vec3::zeros(); grid.cells()];
         for i in 0..positions_m.len() {
@@ -228,31 +233,72 @@ impl FluidForces {
             volume[cells[i]] += v;
             momentum[cells[i]] += velocities_m_per_s[i] * v;
         }
-        for i in 0..positions_m.len() {
+        let mut drag = std::mem::take(&mut self.drag_buffer);
+        drag.resize(positions_m.len(), Vec3::zeros());
+        let this = &*self;
+        let compute = |(i, (d, f)): (usize, (&mut Vec3, &mut Vec3))| {
             let x = &positions_m[i];
-            let c = self.cell_of(x);
             let k_cell = cells[i];
             let v_sm = momentum[k_cell] / volume[k_cell];
-            let slip = self.cell_gas_velocity(c) - v_sm;
-            let k = self.drag.coefficient_n_s_per_m(&DragInput {
-                porosity: self.porosity[k_cell],
+            let slip = this.cell_gas_velocity(this.cell_of(x)) - v_sm;
+            let k = this.drag.coefficient_n_s_per_m(&DragInput {
+                porosity: this.porosity[k_cell],
                 slip_speed_m_per_s: slip.norm(),
                 diameter_m: 2.0 * radii_m[i],
-                gas_density_kg_per_m3: self.gas_density_kg_per_m3,
-                gas_viscosity_pa_s: self.gas_viscosity_pa_s,
+                gas_density_kg_per_m3: this.gas_density_kg_per_m3,
+                gas_viscosity_pa_s: this.gas_viscosity_pa_s,
             });
-            let drag = slip * k;
             let mut grad = Vec3::zeros();
             for a in 0..grid.axes() {
-                grad[a] = interpolate_component(&grid, &self.minus_pressure_gradient_pa_per_m[a], a, x);
+                grad[a] = interpolate_component(&grid, &this.minus_pressure_gradient_pa_per_m[a], a, x);
             }
-            force[i] += drag + grad * (4.0 / 3.0 * PI * radii_m[i].powi(3));
+            *d = slip * k;
+            *f += *d + grad * (4.0 / 3.0 * PI * radii_m[i].powi(3));
+        };
+        match pool {
+            Some(pool) => pool.install(|| {
+                use rayon::prelude::*;
+                drag.par_iter_mut()
+                    .zip(force.par_iter_mut())
+                    .enumerate()
+                    .with_min_len(256)
+                    .for_each(compute)
+            }),
+            None => drag.iter_mut().zip(force.iter_mut()).enumerate().for_each(compute),
+        }
+        let cell_volume = grid.cell_volume_m3();
+        for (x, d) in positions_m.iter().zip(&drag) {
+            let c = self.cell_of(x);
             for a in 0..grid.axes() {
                 for face in self.cell_faces(c, a) {
-                    self.reaction_n_per_m3[a][face] -= 0.5 * drag[a] / cell_volume;
+                    self.reaction_n_per_m3[a][face] -= 0.5 * d[a] / cell_volume;
                 }
             }
         }
+        self.drag_buffer = drag;
+    }
+
+    /// The drag and the total fluid force on particle i (instantaneous velocities).
+    fn instantaneous_force(&self, x: &Vec3, v: &Vec3, r: f64) -> (Vec3, Vec3) {
+        let grid = &self.grid;
+        let volume = 4.0 / 3.0 * PI * r * r * r;
+        let eps = self.porosity[grid.cell(self.cell_of(x))];
+        let mut u = Vec3::zeros();
+        let mut grad = Vec3::zeros();
+        for a in 0..grid.axes() {
+            u[a] = interpolate_component(grid, &self.velocity_m_per_s[a], a, x);
+            grad[a] = interpolate_component(grid, &self.minus_pressure_gradient_pa_per_m[a], a, x);
+        }
+        let slip = u - v;
+        let k = self.drag.coefficient_n_s_per_m(&DragInput {
+            porosity: eps,
+            slip_speed_m_per_s: slip.norm(),
+            diameter_m: 2.0 * r,
+            gas_density_kg_per_m3: self.gas_density_kg_per_m3,
+            gas_viscosity_pa_s: self.gas_viscosity_pa_s,
+        });
+        let drag = slip * k;
+        (drag, drag + grad * volume)
     }
 
     fn add_forces_instantaneous(
@@ -261,39 +307,40 @@ impl FluidForces {
         velocities_m_per_s: &[Vec3],
         radii_m: &[f64],
         force: &mut [Vec3],
+        pool: Option<&rayon::ThreadPool>,
     ) {
-        let grid = self.grid.clone();
-        let cell_volume = grid.cell_volume_m3();
+        // Per-particle forces are independent (any thread count gives the same bits); the reaction is then
+        // scattered serially in particle order.
+        let mut drag = std::mem::take(&mut self.drag_buffer);
+        drag.resize(positions_m.len(), Vec3::zeros());
+        let this = &*self;
+        let compute = |(i, (d, f)): (usize, (&mut Vec3, &mut Vec3))| {
+            let (dr, total) = this.instantaneous_force(&positions_m[i], &velocities_m_per_s[i], radii_m[i]);
+            *d = dr;
+            *f += total;
+        };
+        match pool {
+            Some(pool) => pool.install(|| {
+                use rayon::prelude::*;
+                drag.par_iter_mut()
+                    .zip(force.par_iter_mut())
+                    .enumerate()
+                    .with_min_len(256)
+                    .for_each(compute)
+            }),
+            None => drag.iter_mut().zip(force.iter_mut()).enumerate().for_each(compute),
+        }
+        let cell_volume = self.grid.cell_volume_m3();
         let mut weights = Vec::with_capacity(8);
-        for i in 0..positions_m.len() {
-            let x = &positions_m[i];
-            let r = radii_m[i];
-            let volume = 4.0 / 3.0 * PI * r * r * r;
-            let cell = self.cell_of(x);
-            let eps = self.porosity[grid.cell(cell)];
-            let mut u = Vec3::zeros();
-            let mut grad = Vec3::zeros();
-            for a in 0..grid.axes() {
-                u[a] = interpolate_component(&grid, &self.velocity_m_per_s[a], a, x);
-                grad[a] = interpolate_component(&grid, &self.minus_pressure_gradient_pa_per_m[a], a, x);
-            }
-            let slip = u - velocities_m_per_s[i];
-            let k = self.drag.coefficient_n_s_per_m(&DragInput {
-                porosity: eps,
-                slip_speed_m_per_s: slip.norm(),
-                diameter_m: 2.0 * r,
-                gas_density_kg_per_m3: self.gas_density_kg_per_m3,
-                gas_viscosity_pa_s: self.gas_viscosity_pa_s,
-            });
-            let drag = slip * k;
-            force[i] += drag + grad * volume;
-            for a in 0..grid.axes() {
+        for (x, d) in positions_m.iter().zip(&drag) {
+            for a in 0..self.grid.axes() {
                 self.weights(a, x, &mut weights);
                 for &(face, w) in &weights {
-                    self.reaction_n_per_m3[a][face] -= w * drag[a] / cell_volume;
+                    self.reaction_n_per_m3[a][face] -= w * d[a] / cell_volume;
                 }
             }
         }
+        self.drag_buffer = drag;
     }
 
     /// The mean reaction per unit volume over the DEM steps since the last freeze (the gas's momentum source).

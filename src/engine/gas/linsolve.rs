@@ -76,7 +76,65 @@ fn norm(a: &[f64]) -> f64 {
     dot(a, a).sqrt()
 }
 
-/// Jacobi-preconditioned conjugate gradients for a symmetric system; `x` holds the start and the result. A singular
+/// Diagonal-based incomplete Cholesky (DIC, as in OpenFOAM's PCG): M = (D + L) D⁻¹ (D + Lᵀ) with L the strictly
+/// lower part of A (in unknown order) and D chosen so that diag(M) = diag(A): d_p = a_p − Σ_{k<p} a_pk² / d_k.
+/// For the pressure-correction Poisson systems it needs about half the iterations of Jacobi. Where the
+/// factorisation breaks down (d_p not clearly positive, e.g. the last row of a singular Neumann system) d_p falls
+/// back to a_p.
+struct DiagonalIncompleteCholesky {
+    d: Vec<f64>,
+}
+
+impl DiagonalIncompleteCholesky {
+    fn new(sys: &StencilSystem) -> Self {
+        let n = sys.len();
+        let mut d: Vec<f64> = sys.ap.clone();
+        for p in 0..n {
+            let mut dp = sys.ap[p];
+            for k in 0..NEIGHBOURS {
+                let q = sys.nb[p][k];
+                if q != NONE && (q as usize) < p {
+                    dp -= sys.anb[p][k] * sys.anb[p][k] / d[q as usize];
+                }
+            }
+            d[p] = if dp > 1e-3 * sys.ap[p] && dp.is_finite() {
+                dp
+            } else if sys.ap[p] != 0.0 {
+                sys.ap[p]
+            } else {
+                1.0
+            };
+        }
+        DiagonalIncompleteCholesky { d }
+    }
+
+    /// z = M⁻¹ r: forward (D + L) w = r, then backward (D + Lᵀ) z = D w.
+    fn apply(&self, sys: &StencilSystem, r: &[f64], z: &mut [f64]) {
+        let n = sys.len();
+        for p in 0..n {
+            let mut s = r[p];
+            for k in 0..NEIGHBOURS {
+                let q = sys.nb[p][k];
+                if q != NONE && (q as usize) < p {
+                    s += sys.anb[p][k] * z[q as usize];
+                }
+            }
+            z[p] = s / self.d[p];
+        }
+        for p in (0..n).rev() {
+            let mut s = 0.0;
+            for k in 0..NEIGHBOURS {
+                let q = sys.nb[p][k];
+                if q != NONE && (q as usize) > p {
+                    s += sys.anb[p][k] * z[q as usize];
+                }
+            }
+            z[p] += s / self.d[p];
+        }
+    }
+}
+
+/// Conjugate gradients preconditioned by diagonal-based incomplete Cholesky for a symmetric system; `x` holds the start and the result. A singular
 /// but consistent system (pure Neumann pressure correction) converges to a solution; `remove_mean` then subtracts
 /// the mean of `x` (the undetermined constant).
 pub fn conjugate_gradient(
@@ -96,10 +154,11 @@ pub fn conjugate_gradient(
             converged: true,
         };
     }
-    let inv_diag: Vec<f64> = sys.ap.iter().map(|a| if *a != 0.0 { 1.0 / a } else { 1.0 }).collect();
+    let precond = DiagonalIncompleteCholesky::new(sys);
     let mut r = vec![0.0; n];
     sys.residual(x, &mut r);
-    let mut z: Vec<f64> = r.iter().zip(&inv_diag).map(|(a, d)| a * d).collect();
+    let mut z = vec![0.0; n];
+    precond.apply(sys, &r, &mut z);
     let mut p = z.clone();
     let mut q = vec![0.0; n];
     let mut rz = dot(&r, &z);
@@ -116,9 +175,7 @@ pub fn conjugate_gradient(
             x[i] += alpha * p[i];
             r[i] -= alpha * q[i];
         }
-        for i in 0..n {
-            z[i] = r[i] * inv_diag[i];
-        }
+        precond.apply(sys, &r, &mut z);
         let rz_new = dot(&r, &z);
         let beta = rz_new / rz;
         rz = rz_new;
