@@ -57,9 +57,18 @@ fn run_ok(args: &[&str], cwd: &Path) -> String {
 
 #[test]
 fn a_fluidized_bed_restarts_bit_identically_with_its_gas() {
+    restart_is_exact("");
+}
+
+#[test]
+fn a_semi_implicit_bed_restarts_bit_identically_with_its_gas() {
+    restart_is_exact("  drag_coupling: semi_implicit\n  drag_velocities: cell_averaged");
+}
+
+fn restart_is_exact(extra: &str) {
     let tmp = tempfile::tempdir().expect("temp dir");
     let dir = tmp.path();
-    std::fs::write(dir.join("bed.yaml"), bed(0.03, "")).expect("write scenario");
+    std::fs::write(dir.join("bed.yaml"), bed(0.03, extra)).expect("write scenario");
     run_ok(&["simulate", "bed.yaml", "--out", "whole", "--quiet"], dir);
     // 1503 steps: the stop falls 5 DEM steps into a gas step (the drag reaction sum is mid-way).
     run_ok(

@@ -229,3 +229,43 @@ fn cell_averaged_drag_gives_the_gas_exactly_what_the_particles_get() {
         "cell-averaged drag does not depend on the position inside the cell"
     );
 }
+
+#[test]
+fn fluid_forces_on_a_pool_give_the_same_bits_as_on_one_thread() {
+    let sim = settling(1);
+    let pool = rayon::ThreadPoolBuilder::new().num_threads(2).build().unwrap();
+    for method in [DragVelocities::Instantaneous, DragVelocities::CellAveraged] {
+        let mut serial = sim.gas.as_ref().unwrap().fluid.clone();
+        serial.drag_velocities = method;
+        for a in 0..3 {
+            for (f, v) in serial.velocity_m_per_s[a].iter_mut().enumerate() {
+                *v = 0.013 * (f % 5) as f64 - 0.01 * a as f64;
+            }
+            for (f, g) in serial.minus_pressure_gradient_pa_per_m[a].iter_mut().enumerate() {
+                *g = 3.0 * (f % 3) as f64;
+            }
+        }
+        let mut parallel = serial.clone();
+        // Enough particles for several parallel chunks.
+        let n = 3000;
+        let positions: Vec<Vec3> = (0..n)
+            .map(|k| {
+                let t = k as f64;
+                Vec3::new((t * 0.000_37) % 0.009, (t * 0.000_53) % 0.009, (t * 0.000_11) % 0.03)
+            })
+            .collect();
+        let velocities: Vec<Vec3> = (0..n)
+            .map(|k| Vec3::new(0.001 * (k % 7) as f64, -0.02, 0.003))
+            .collect();
+        let radii = vec![RADIUS; n];
+        let (mut f1, mut f2) = (vec![Vec3::zeros(); n], vec![Vec3::zeros(); n]);
+        serial.add_forces(&positions, &velocities, &radii, &mut f1, None);
+        parallel.add_forces(&positions, &velocities, &radii, &mut f2, Some(&pool));
+        assert!(f1.iter().zip(&f2).all(|(a, b)| a == b), "{method:?}: forces differ");
+        for a in 0..3 {
+            assert_eq!(serial.reaction_n_per_m3[a], parallel.reaction_n_per_m3[a], "{method:?}");
+            assert_eq!(serial.beta_sum[a], parallel.beta_sum[a], "{method:?}");
+            assert_eq!(serial.beta_velocity_sum[a], parallel.beta_velocity_sum[a], "{method:?}");
+        }
+    }
+}

@@ -205,6 +205,12 @@ datasets! {
     gas_reaction_x: f64 => "gas/drag_reaction_sum_x_n_per_m3", Rows::GasFaces(0), 1, "N/m3";
     gas_reaction_y: f64 => "gas/drag_reaction_sum_y_n_per_m3", Rows::GasFaces(1), 1, "N/m3";
     gas_reaction_z: f64 => "gas/drag_reaction_sum_z_n_per_m3", Rows::GasFaces(2), 1, "N/m3";
+    gas_beta_x: f64 => "gas/drag_beta_sum_x_n_s_per_m4", Rows::GasFaces(0), 1, "N s/m4";
+    gas_beta_y: f64 => "gas/drag_beta_sum_y_n_s_per_m4", Rows::GasFaces(1), 1, "N s/m4";
+    gas_beta_z: f64 => "gas/drag_beta_sum_z_n_s_per_m4", Rows::GasFaces(2), 1, "N s/m4";
+    gas_beta_v_x: f64 => "gas/drag_beta_velocity_sum_x_n_per_m3", Rows::GasFaces(0), 1, "N/m3";
+    gas_beta_v_y: f64 => "gas/drag_beta_velocity_sum_y_n_per_m3", Rows::GasFaces(1), 1, "N/m3";
+    gas_beta_v_z: f64 => "gas/drag_beta_velocity_sum_z_n_per_m3", Rows::GasFaces(2), 1, "N/m3";
     gas_time_s: f64 => "gas/time_s", Rows::GasScalar, 1, "s";
     gas_reaction_steps: u32 => "gas/drag_reaction_steps", Rows::GasScalar, 1, "1";
     gas_last_outer_iterations: u64 => "gas/last_step/outer_iterations", Rows::GasScalar, 1, "1";
@@ -357,6 +363,12 @@ impl Arrays {
             gas_reaction_x: gas.map(|g| g.reaction_n_per_m3[0].clone()).unwrap_or_default(),
             gas_reaction_y: gas.map(|g| g.reaction_n_per_m3[1].clone()).unwrap_or_default(),
             gas_reaction_z: gas.map(|g| g.reaction_n_per_m3[2].clone()).unwrap_or_default(),
+            gas_beta_x: gas.map(|g| g.beta_sum[0].clone()).unwrap_or_default(),
+            gas_beta_y: gas.map(|g| g.beta_sum[1].clone()).unwrap_or_default(),
+            gas_beta_z: gas.map(|g| g.beta_sum[2].clone()).unwrap_or_default(),
+            gas_beta_v_x: gas.map(|g| g.beta_velocity_sum[0].clone()).unwrap_or_default(),
+            gas_beta_v_y: gas.map(|g| g.beta_velocity_sum[1].clone()).unwrap_or_default(),
+            gas_beta_v_z: gas.map(|g| g.beta_velocity_sum[2].clone()).unwrap_or_default(),
             gas_time_s: gas.map(|g| g.time_s).into_iter().collect(),
             gas_reaction_steps: gas.map(|g| g.reaction_steps).into_iter().collect(),
             gas_last_outer_iterations: gas.map(|g| g.last.outer_iterations).into_iter().collect(),
@@ -477,6 +489,8 @@ impl Arrays {
             porosity: self.gas_porosity,
             time_s: self.gas_time_s[0],
             reaction_n_per_m3: [self.gas_reaction_x, self.gas_reaction_y, self.gas_reaction_z],
+            beta_sum: [self.gas_beta_x, self.gas_beta_y, self.gas_beta_z],
+            beta_velocity_sum: [self.gas_beta_v_x, self.gas_beta_v_y, self.gas_beta_v_z],
             reaction_steps: self.gas_reaction_steps[0],
             last: GasStepStats {
                 outer_iterations: self.gas_last_outer_iterations[0],

@@ -502,6 +502,8 @@ mod tests {
                 porosity: vec![0.41, 0.5, 0.999, 1.0, 0.6, 0.45],
                 time_s: 0.012,
                 reaction_n_per_m3: [vec![1.5; 9], vec![-2.25; 8], vec![0.0; 12]],
+                beta_sum: [vec![310.5; 9], vec![12.0; 8], vec![0.0; 12]],
+                beta_velocity_sum: [vec![-3.5; 9], vec![7.25e-3; 8], vec![0.0; 12]],
                 reaction_steps: 7,
                 last: crate::engine::gas::coupled::GasStepStats {
                     outer_iterations: 12,

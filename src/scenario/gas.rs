@@ -11,7 +11,7 @@ use super::ConfigError;
 use crate::engine::Vec3;
 use crate::engine::gas::coupled::GasCoupling;
 use crate::engine::gas::coupling::PorosityMethod;
-use crate::engine::gas::fluid_forces::DragVelocities;
+use crate::engine::gas::fluid_forces::{DragCoupling, DragVelocities};
 use crate::engine::gas::grid::side;
 use crate::engine::gas::simple::InletFace;
 use crate::engine::gas::{Boundary, Convection, GasConfig, Grid};
@@ -40,6 +40,10 @@ pub struct GasSpec {
     /// `cell_averaged` (seed 002's method 1: the cell's mean particle velocity and centre gas velocity).
     #[serde(default)]
     pub drag_velocities: DragVelocities,
+    /// How the gas receives the drag: `explicit` (exactly what the particles got; needs gas steps below about
+    /// 2 ρ_g ε / β) or `semi_implicit` (−β u_new + β v: stable for dense beds and strong jets).
+    #[serde(default)]
+    pub drag_coupling: DragCoupling,
     /// How particle volume becomes cell porosity (default `volume_split`).
     #[serde(default)]
     pub porosity: PorosityMethod,
@@ -196,6 +200,7 @@ pub struct GasSetup {
     pub config: GasConfig,
     pub drag: DragLaw,
     pub drag_velocities: DragVelocities,
+    pub drag_coupling: DragCoupling,
     pub porosity_method: PorosityMethod,
     pub min_porosity: f64,
     pub dem_steps_per_gas_step: u64,
@@ -205,7 +210,7 @@ pub struct GasSetup {
 impl GasSetup {
     /// The gas around particles at `positions_m`.
     pub fn coupling(&self, positions_m: &[Vec3], radii_m: &[f64]) -> Result<GasCoupling, String> {
-        GasCoupling::new(
+        let mut coupling = GasCoupling::new(
             self.config.clone(),
             self.drag,
             self.drag_velocities,
@@ -214,7 +219,9 @@ impl GasSetup {
             self.dem_steps_per_gas_step,
             positions_m,
             radii_m,
-        )
+        )?;
+        coupling.drag_coupling = self.drag_coupling;
+        Ok(coupling)
     }
 }
 
@@ -470,6 +477,7 @@ pub fn build_gas(
         config,
         drag: spec.drag,
         drag_velocities: spec.drag_velocities,
+        drag_coupling: spec.drag_coupling,
         porosity_method: spec.porosity,
         min_porosity: spec.min_porosity,
         dem_steps_per_gas_step: spec.dem_steps_per_gas_step,

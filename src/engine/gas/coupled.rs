@@ -8,7 +8,7 @@
 //! `dem_steps_per_gas_step`-th step; its state ([`GasSnapshot`]) is part of the checkpoint.
 
 use super::coupling::{PorosityMethod, porosity};
-use super::fluid_forces::{DragVelocities, FluidForces};
+use super::fluid_forces::{DragCoupling, DragVelocities, FluidForces};
 use super::grid::{Boundary, side};
 use super::simple::{GasConfig, GasSolver};
 use crate::engine::Vec3;
@@ -32,6 +32,8 @@ pub struct GasSnapshot {
     pub porosity: Vec<f64>,
     pub time_s: f64,
     pub reaction_n_per_m3: [Vec<f64>; 3],
+    pub beta_sum: [Vec<f64>; 3],
+    pub beta_velocity_sum: [Vec<f64>; 3],
     pub reaction_steps: u32,
     pub last: GasStepStats,
 }
@@ -43,6 +45,7 @@ pub struct GasCoupling {
     /// Porosity is not allowed below this (a cell over-filled by the split would otherwise reach 0).
     pub min_porosity: f64,
     pub dem_steps_per_gas_step: u64,
+    pub drag_coupling: DragCoupling,
     /// A uniform force per unit volume on the gas besides drag, N/m³ (e.g. in a periodic box, the mean pressure
     /// gradient that carries the particles' weight, without which the mixture would accelerate for ever).
     pub gas_body_force_n_per_m3: [f64; 3],
@@ -88,6 +91,7 @@ impl GasCoupling {
             porosity_method,
             min_porosity,
             dem_steps_per_gas_step,
+            drag_coupling: DragCoupling::Explicit,
             gas_body_force_n_per_m3: [0.0; 3],
             last: GasStepStats::default(),
             linear_solve_s: 0.0,
@@ -101,11 +105,17 @@ impl GasCoupling {
         let grid = &self.solver.config.grid;
         let new_porosity = porosity(grid, self.porosity_method, positions_m, radii_m, self.min_porosity);
         let old_porosity = std::mem::replace(&mut self.solver.state.porosity, new_porosity);
-        let mut source = self.fluid.mean_reaction();
+        let (mut source, sink) = match self.drag_coupling {
+            DragCoupling::Explicit => (self.fluid.mean_reaction(), Default::default()),
+            DragCoupling::SemiImplicit => {
+                let (beta, beta_v) = self.fluid.mean_exchange();
+                (beta_v, beta)
+            }
+        };
         for (a, s) in source.iter_mut().enumerate() {
             s.iter_mut().for_each(|v| *v += self.gas_body_force_n_per_m3[a]);
         }
-        let report = self.solver.step(dt_s, &source, &Default::default(), &old_porosity);
+        let report = self.solver.step(dt_s, &source, &sink, &old_porosity);
         self.linear_solve_s += report.linear_solve_s;
         let state = &self.solver.state;
         if let Some(k) = state.pressure_pa.iter().position(|p| !p.is_finite()) {
@@ -138,6 +148,8 @@ impl GasCoupling {
             porosity: s.porosity.clone(),
             time_s: s.time_s,
             reaction_n_per_m3: self.fluid.reaction_n_per_m3.clone(),
+            beta_sum: self.fluid.beta_sum.clone(),
+            beta_velocity_sum: self.fluid.beta_velocity_sum.clone(),
             reaction_steps: self.fluid.steps,
             last: self.last,
         }
@@ -155,7 +167,12 @@ impl GasCoupling {
             ));
         }
         for a in 0..3 {
-            if snap.velocity_m_per_s[a].len() != grid.faces(a) || snap.reaction_n_per_m3[a].len() != grid.faces(a) {
+            let n = grid.faces(a);
+            if snap.velocity_m_per_s[a].len() != n
+                || snap.reaction_n_per_m3[a].len() != n
+                || snap.beta_sum[a].len() != n
+                || snap.beta_velocity_sum[a].len() != n
+            {
                 return Err(format!(
                     "the checkpoint's gas has {} faces along axis {a}, the scenario's grid {}",
                     snap.velocity_m_per_s[a].len(),
@@ -172,6 +189,8 @@ impl GasCoupling {
         let s = &self.solver.state;
         self.fluid.freeze(&u, &s.pressure_pa, &s.porosity);
         self.fluid.reaction_n_per_m3.clone_from(&snap.reaction_n_per_m3);
+        self.fluid.beta_sum.clone_from(&snap.beta_sum);
+        self.fluid.beta_velocity_sum.clone_from(&snap.beta_velocity_sum);
         self.fluid.steps = snap.reaction_steps;
         self.last = snap.last;
         Ok(())

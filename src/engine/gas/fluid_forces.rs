@@ -16,6 +16,20 @@ use super::grid::Grid;
 use crate::engine::Vec3;
 use crate::engine::models::drag::{DragInput, DragLaw};
 
+/// How the gas receives the drag (the particles always get K (u − v) under the frozen field).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize, schemars::JsonSchema)]
+#[serde(rename_all = "snake_case")]
+pub enum DragCoupling {
+    /// The gas gets exactly −Σ K (u − v) the particles got, as an explicit source: momentum is conserved to
+    /// rounding; stable while the gas step is below about 2 ρ_g ε / β.
+    #[default]
+    Explicit,
+    /// The gas gets −β u_new + β v with β = Σ w K / V (CFDEM's implicit coupling): unconditionally stable in the
+    /// exchange term; the momentum it receives differs from the particles' by Σ K (u_new − u_frozen) (the change
+    /// of the gas velocity over one gas step).
+    SemiImplicit,
+}
+
 /// Which velocities the drag on a particle is computed from (seed 002 §3.3).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize, schemars::JsonSchema)]
 #[serde(rename_all = "snake_case")]
@@ -42,9 +56,14 @@ pub struct FluidForces {
     pub porosity: Vec<f64>,
     /// Σ over DEM steps of the force on the gas per unit volume at each face, N/m³ (divide by `steps`).
     pub reaction_n_per_m3: [Vec<f64>; 3],
+    /// Σ over DEM steps of w K / V_cell at each face, N·s/m⁴: the exchange coefficient β the semi-implicit
+    /// coupling puts into the gas momentum equation as −β u.
+    pub beta_sum: [Vec<f64>; 3],
+    /// Σ over DEM steps of w K v / V_cell at each face (v the particle velocity the drag used), N/m³: its +β v.
+    pub beta_velocity_sum: [Vec<f64>; 3],
     pub steps: u32,
-    /// Workspace: each particle's drag of the current step.
-    drag_buffer: Vec<Vec3>,
+    /// Workspace: each particle's drag of the current step, its coefficient K and the particle velocity used.
+    drag_buffer: Vec<(Vec3, f64, Vec3)>,
 }
 
 impl FluidForces {
@@ -54,6 +73,8 @@ impl FluidForces {
             velocity_m_per_s: zeros(&grid),
             minus_pressure_gradient_pa_per_m: zeros(&grid),
             reaction_n_per_m3: zeros(&grid),
+            beta_sum: zeros(&grid),
+            beta_velocity_sum: zeros(&grid),
             porosity: vec![1.0; grid.cells()],
             steps: 0,
             drag_buffer: Vec::new(),
@@ -97,7 +118,12 @@ impl FluidForces {
             }
         }
         self.porosity.copy_from_slice(porosity);
-        for r in &mut self.reaction_n_per_m3 {
+        for r in self
+            .reaction_n_per_m3
+            .iter_mut()
+            .chain(self.beta_sum.iter_mut())
+            .chain(self.beta_velocity_sum.iter_mut())
+        {
             r.iter_mut().for_each(|v| *v = 0.0);
         }
         self.steps = 0;
@@ -233,27 +259,38 @@ impl FluidForces {
             volume[cells[i]] += v;
             momentum[cells[i]] += velocities_m_per_s[i] * v;
         }
+        // Per occupied cell: v_sm, the slip, and K for the diameter of the cell's first particle (every particle
+        // of that diameter in the cell has the same K, so the drag law runs once per cell for a monodisperse bed).
+        let mut slip_of_cell = vec![Vec3::zeros(); grid.cells()];
+        let mut k_of_cell = vec![(f64::NAN, 0.0); grid.cells()];
+        for i in 0..positions_m.len() {
+            let c = cells[i];
+            if k_of_cell[c].0.is_nan() {
+                let slip = self.cell_gas_velocity(self.cell_of(&positions_m[i])) - momentum[c] / volume[c];
+                slip_of_cell[c] = slip;
+                k_of_cell[c] = (radii_m[i], self.cell_drag_coefficient(c, &slip, radii_m[i]));
+            }
+        }
         let mut drag = std::mem::take(&mut self.drag_buffer);
-        drag.resize(positions_m.len(), Vec3::zeros());
+        drag.resize(positions_m.len(), (Vec3::zeros(), 0.0, Vec3::zeros()));
         let this = &*self;
-        let compute = |(i, (d, f)): (usize, (&mut Vec3, &mut Vec3))| {
+        let compute = |(i, (d, f)): (usize, (&mut (Vec3, f64, Vec3), &mut Vec3))| {
             let x = &positions_m[i];
             let k_cell = cells[i];
             let v_sm = momentum[k_cell] / volume[k_cell];
-            let slip = this.cell_gas_velocity(this.cell_of(x)) - v_sm;
-            let k = this.drag.coefficient_n_s_per_m(&DragInput {
-                porosity: this.porosity[k_cell],
-                slip_speed_m_per_s: slip.norm(),
-                diameter_m: 2.0 * radii_m[i],
-                gas_density_kg_per_m3: this.gas_density_kg_per_m3,
-                gas_viscosity_pa_s: this.gas_viscosity_pa_s,
-            });
+            let slip = slip_of_cell[k_cell];
+            let (r_ref, k_ref) = k_of_cell[k_cell];
+            let k = if radii_m[i] == r_ref {
+                k_ref
+            } else {
+                this.cell_drag_coefficient(k_cell, &slip, radii_m[i])
+            };
             let mut grad = Vec3::zeros();
             for a in 0..grid.axes() {
                 grad[a] = interpolate_component(&grid, &this.minus_pressure_gradient_pa_per_m[a], a, x);
             }
-            *d = slip * k;
-            *f += *d + grad * (4.0 / 3.0 * PI * radii_m[i].powi(3));
+            *d = (slip * k, k, v_sm);
+            *f += d.0 + grad * (4.0 / 3.0 * PI * radii_m[i].powi(3));
         };
         match pool {
             Some(pool) => pool.install(|| {
@@ -267,19 +304,32 @@ impl FluidForces {
             None => drag.iter_mut().zip(force.iter_mut()).enumerate().for_each(compute),
         }
         let cell_volume = grid.cell_volume_m3();
-        for (x, d) in positions_m.iter().zip(&drag) {
+        for (x, (d, k, v)) in positions_m.iter().zip(&drag) {
             let c = self.cell_of(x);
             for a in 0..grid.axes() {
                 for face in self.cell_faces(c, a) {
                     self.reaction_n_per_m3[a][face] -= 0.5 * d[a] / cell_volume;
+                    self.beta_sum[a][face] += 0.5 * k / cell_volume;
+                    self.beta_velocity_sum[a][face] += 0.5 * k * v[a] / cell_volume;
                 }
             }
         }
         self.drag_buffer = drag;
     }
 
-    /// The drag and the total fluid force on particle i (instantaneous velocities).
-    fn instantaneous_force(&self, x: &Vec3, v: &Vec3, r: f64) -> (Vec3, Vec3) {
+    /// K of a particle of radius `r` in cell `c` at slip `slip` (the cell-averaged method).
+    fn cell_drag_coefficient(&self, c: usize, slip: &Vec3, r: f64) -> f64 {
+        self.drag.coefficient_n_s_per_m(&DragInput {
+            porosity: self.porosity[c],
+            slip_speed_m_per_s: slip.norm(),
+            diameter_m: 2.0 * r,
+            gas_density_kg_per_m3: self.gas_density_kg_per_m3,
+            gas_viscosity_pa_s: self.gas_viscosity_pa_s,
+        })
+    }
+
+    /// The drag, its coefficient K and the total fluid force on particle i (instantaneous velocities).
+    fn instantaneous_force(&self, x: &Vec3, v: &Vec3, r: f64) -> (Vec3, f64, Vec3) {
         let grid = &self.grid;
         let volume = 4.0 / 3.0 * PI * r * r * r;
         let eps = self.porosity[grid.cell(self.cell_of(x))];
@@ -298,7 +348,7 @@ impl FluidForces {
             gas_viscosity_pa_s: self.gas_viscosity_pa_s,
         });
         let drag = slip * k;
-        (drag, drag + grad * volume)
+        (drag, k, drag + grad * volume)
     }
 
     fn add_forces_instantaneous(
@@ -312,11 +362,11 @@ impl FluidForces {
         // Per-particle forces are independent (any thread count gives the same bits); the reaction is then
         // scattered serially in particle order.
         let mut drag = std::mem::take(&mut self.drag_buffer);
-        drag.resize(positions_m.len(), Vec3::zeros());
+        drag.resize(positions_m.len(), (Vec3::zeros(), 0.0, Vec3::zeros()));
         let this = &*self;
-        let compute = |(i, (d, f)): (usize, (&mut Vec3, &mut Vec3))| {
-            let (dr, total) = this.instantaneous_force(&positions_m[i], &velocities_m_per_s[i], radii_m[i]);
-            *d = dr;
+        let compute = |(i, (d, f)): (usize, (&mut (Vec3, f64, Vec3), &mut Vec3))| {
+            let (dr, k, total) = this.instantaneous_force(&positions_m[i], &velocities_m_per_s[i], radii_m[i]);
+            *d = (dr, k, velocities_m_per_s[i]);
             *f += total;
         };
         match pool {
@@ -332,11 +382,13 @@ impl FluidForces {
         }
         let cell_volume = self.grid.cell_volume_m3();
         let mut weights = Vec::with_capacity(8);
-        for (x, d) in positions_m.iter().zip(&drag) {
+        for (x, (d, k, v)) in positions_m.iter().zip(&drag) {
             for a in 0..self.grid.axes() {
                 self.weights(a, x, &mut weights);
                 for &(face, w) in &weights {
                     self.reaction_n_per_m3[a][face] -= w * d[a] / cell_volume;
+                    self.beta_sum[a][face] += w * k / cell_volume;
+                    self.beta_velocity_sum[a][face] += w * k * v[a] / cell_volume;
                 }
             }
         }
@@ -345,7 +397,20 @@ impl FluidForces {
 
     /// The mean reaction per unit volume over the DEM steps since the last freeze (the gas's momentum source).
     pub fn mean_reaction(&self) -> [Vec<f64>; 3] {
-        let n = f64::from(self.steps.max(1));
-        std::array::from_fn(|a| self.reaction_n_per_m3[a].iter().map(|v| v / n).collect())
+        Self::mean(&self.reaction_n_per_m3, self.steps)
+    }
+
+    /// The semi-implicit form of the same exchange: (β, β v) per face, averaged over the DEM steps since the last
+    /// freeze; the gas then feels −β u_new + β v.
+    pub fn mean_exchange(&self) -> ([Vec<f64>; 3], [Vec<f64>; 3]) {
+        (
+            Self::mean(&self.beta_sum, self.steps),
+            Self::mean(&self.beta_velocity_sum, self.steps),
+        )
+    }
+
+    fn mean(sum: &[Vec<f64>; 3], steps: u32) -> [Vec<f64>; 3] {
+        let n = f64::from(steps.max(1));
+        std::array::from_fn(|a| sum[a].iter().map(|v| v / n).collect())
     }
 }

@@ -10,7 +10,8 @@
 //!
 //! Each time step: outer iterations of (momentum predictor with the current pressure → pressure correction from
 //! continuity → corrected pressure and velocities), under-relaxed, until the mass imbalance is below tolerance.
-//! Momentum systems go to BiCGStab, the pressure correction to conjugate gradients (both Jacobi-preconditioned).
+//! Momentum systems go to BiCGStab (Jacobi-preconditioned), the pressure correction to conjugate gradients
+//! preconditioned by diagonal incomplete Cholesky.
 
 use serde::{Deserialize, Serialize};
 
