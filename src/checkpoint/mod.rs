@@ -1032,6 +1032,24 @@ mod tests {
                 &f(v.iter().copied()),
             );
         }
+        for (k, axis) in ["x", "y", "z"].iter().enumerate() {
+            let v = &gas.beta_sum[k];
+            ds(
+                &mut b,
+                &format!("gas/drag_beta_sum_{axis}_n_s_per_m4"),
+                &[v.len()],
+                &f(v.iter().copied()),
+            );
+        }
+        for (k, axis) in ["x", "y", "z"].iter().enumerate() {
+            let v = &gas.beta_velocity_sum[k];
+            ds(
+                &mut b,
+                &format!("gas/drag_beta_velocity_sum_{axis}_n_per_m3"),
+                &[v.len()],
+                &f(v.iter().copied()),
+            );
+        }
         ds(&mut b, "gas/time_s", &[1], &gas.time_s.to_bits().to_le_bytes());
         ds(
             &mut b,

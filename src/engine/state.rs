@@ -169,6 +169,14 @@ pub fn first_difference(a: &SimState, b: &SimState) -> Option<String> {
                             &h.reaction_n_per_m3[k],
                         )
                     })
+                    .or_else(|| scalars(&format!("gas.beta_sum[{k}]"), &g.beta_sum[k], &h.beta_sum[k]))
+                    .or_else(|| {
+                        scalars(
+                            &format!("gas.beta_velocity_sum[{k}]"),
+                            &g.beta_velocity_sum[k],
+                            &h.beta_velocity_sum[k],
+                        )
+                    })
                 })
             })
             .or_else(|| (g.reaction_steps != h.reaction_steps).then(|| "gas.reaction_steps".to_string()));
