@@ -41,6 +41,28 @@ pub enum DragVelocities {
     CellAveraged,
 }
 
+/// Each particle's drag record of one step.
+type DragRecord = (Vec3, f64, Vec3);
+
+/// Runs `compute` for every particle (index, its drag record, its force), on `pool` when given. Particles are
+/// independent, so the result is the same on any thread count.
+fn per_particle<F>(pool: Option<&rayon::ThreadPool>, drag: &mut [DragRecord], force: &mut [Vec3], compute: F)
+where
+    F: Fn((usize, (&mut DragRecord, &mut Vec3))) + Sync + Send,
+{
+    match pool {
+        Some(pool) => pool.install(|| {
+            use rayon::prelude::*;
+            drag.par_iter_mut()
+                .zip(force.par_iter_mut())
+                .enumerate()
+                .with_min_len(256)
+                .for_each(compute)
+        }),
+        None => drag.iter_mut().zip(force.iter_mut()).enumerate().for_each(compute),
+    }
+}
+
 /// A frozen gas field and the reaction accumulated since it was frozen.
 #[derive(Debug, Clone)]
 pub struct FluidForces {
@@ -63,7 +85,7 @@ pub struct FluidForces {
     pub beta_velocity_sum: [Vec<f64>; 3],
     pub steps: u32,
     /// Workspace: each particle's drag of the current step, its coefficient K and the particle velocity used.
-    drag_buffer: Vec<(Vec3, f64, Vec3)>,
+    drag_buffer: Vec<DragRecord>,
 }
 
 impl FluidForces {
@@ -274,7 +296,7 @@ impl FluidForces {
         let mut drag = std::mem::take(&mut self.drag_buffer);
         drag.resize(positions_m.len(), (Vec3::zeros(), 0.0, Vec3::zeros()));
         let this = &*self;
-        let compute = |(i, (d, f)): (usize, (&mut (Vec3, f64, Vec3), &mut Vec3))| {
+        let compute = |(i, (d, f)): (usize, (&mut DragRecord, &mut Vec3))| {
             let x = &positions_m[i];
             let k_cell = cells[i];
             let v_sm = momentum[k_cell] / volume[k_cell];
@@ -292,17 +314,7 @@ impl FluidForces {
             *d = (slip * k, k, v_sm);
             *f += d.0 + grad * (4.0 / 3.0 * PI * radii_m[i].powi(3));
         };
-        match pool {
-            Some(pool) => pool.install(|| {
-                use rayon::prelude::*;
-                drag.par_iter_mut()
-                    .zip(force.par_iter_mut())
-                    .enumerate()
-                    .with_min_len(256)
-                    .for_each(compute)
-            }),
-            None => drag.iter_mut().zip(force.iter_mut()).enumerate().for_each(compute),
-        }
+        per_particle(pool, &mut drag, force, compute);
         let cell_volume = grid.cell_volume_m3();
         for (x, (d, k, v)) in positions_m.iter().zip(&drag) {
             let c = self.cell_of(x);
@@ -364,22 +376,12 @@ impl FluidForces {
         let mut drag = std::mem::take(&mut self.drag_buffer);
         drag.resize(positions_m.len(), (Vec3::zeros(), 0.0, Vec3::zeros()));
         let this = &*self;
-        let compute = |(i, (d, f)): (usize, (&mut (Vec3, f64, Vec3), &mut Vec3))| {
+        let compute = |(i, (d, f)): (usize, (&mut DragRecord, &mut Vec3))| {
             let (dr, k, total) = this.instantaneous_force(&positions_m[i], &velocities_m_per_s[i], radii_m[i]);
             *d = (dr, k, velocities_m_per_s[i]);
             *f += total;
         };
-        match pool {
-            Some(pool) => pool.install(|| {
-                use rayon::prelude::*;
-                drag.par_iter_mut()
-                    .zip(force.par_iter_mut())
-                    .enumerate()
-                    .with_min_len(256)
-                    .for_each(compute)
-            }),
-            None => drag.iter_mut().zip(force.iter_mut()).enumerate().for_each(compute),
-        }
+        per_particle(pool, &mut drag, force, compute);
         let cell_volume = self.grid.cell_volume_m3();
         let mut weights = Vec::with_capacity(8);
         for (x, (d, k, v)) in positions_m.iter().zip(&drag) {
