@@ -113,9 +113,11 @@ pub fn porosity(grid: &Grid, method: PorosityMethod, positions_m: &[Vec3], radii
         .collect()
 }
 
-/// One velocity component at a point: trilinear interpolation between the component's face values (faces sit at
-/// i·h along their axis and at cell centres across it), clamped at non-periodic edges, wrapped on periodic axes.
-pub fn interpolate_component(grid: &Grid, values: &[f64], axis: usize, x: &Vec3) -> f64 {
+/// The trilinear stencil of the component along `axis` at `x`: up to 8 (face index, weight) pairs with non-zero
+/// weight, in corner order (faces sit at i·h along their axis and at cell centres across it; clamped at
+/// non-periodic edges, wrapped on periodic axes). Shared by interpolation and by the spreading of the drag reaction,
+/// so both use the same weights.
+pub fn face_stencil(grid: &Grid, axis: usize, x: &Vec3) -> ([([usize; 3], f64); 8], usize) {
     let dims = grid.face_dims(axis);
     let mut lo = [0usize; 3];
     let mut hi = [0usize; 3];
@@ -128,21 +130,20 @@ pub fn interpolate_component(grid: &Grid, values: &[f64], axis: usize, x: &Vec3)
         let base = base as isize;
         if grid.periodic(a) {
             let n = grid.n[a] as isize;
-            lo[a] = base.rem_euclid(n) as usize;
-            hi[a] = (base + 1).rem_euclid(n) as usize;
-            w[a] = frac;
+            (lo[a], hi[a], w[a]) = (base.rem_euclid(n) as usize, (base + 1).rem_euclid(n) as usize, frac);
         } else {
             let max = dims[a] as isize - 1;
-            if base < 0 {
-                (lo[a], hi[a], w[a]) = (0, 0, 0.0);
+            (lo[a], hi[a], w[a]) = if base < 0 {
+                (0, 0, 0.0)
             } else if base >= max {
-                (lo[a], hi[a], w[a]) = (max as usize, max as usize, 0.0);
+                (max as usize, max as usize, 0.0)
             } else {
-                (lo[a], hi[a], w[a]) = (base as usize, base as usize + 1, frac);
-            }
+                (base as usize, base as usize + 1, frac)
+            };
         }
     }
-    let mut sum = 0.0;
+    let mut out = [([0usize; 3], 0.0); 8];
+    let mut count = 0;
     for corner in 0..8 {
         let mut idx = [0usize; 3];
         let mut weight = 1.0;
@@ -152,8 +153,20 @@ pub fn interpolate_component(grid: &Grid, values: &[f64], axis: usize, x: &Vec3)
             weight *= if upper { w[a] } else { 1.0 - w[a] };
         }
         if weight != 0.0 {
-            sum += weight * values[grid.face(axis, idx)];
+            out[count] = (idx, weight);
+            count += 1;
         }
+    }
+    (out, count)
+}
+
+/// One velocity component at a point: trilinear interpolation between the component's face values
+/// ([`face_stencil`]).
+pub fn interpolate_component(grid: &Grid, values: &[f64], axis: usize, x: &Vec3) -> f64 {
+    let (stencil, count) = face_stencil(grid, axis, x);
+    let mut sum = 0.0;
+    for &(idx, weight) in &stencil[..count] {
+        sum += weight * values[grid.face(axis, idx)];
     }
     sum
 }

@@ -11,7 +11,7 @@ use std::f64::consts::PI;
 
 use serde::{Deserialize, Serialize};
 
-use super::coupling::interpolate_component;
+use super::coupling::{face_stencil, interpolate_component};
 use super::grid::Grid;
 use crate::engine::Vec3;
 use crate::engine::models::drag::{DragInput, DragLaw};
@@ -151,45 +151,13 @@ impl FluidForces {
         self.steps = 0;
     }
 
-    /// The trilinear weights of component `axis` at `x`, each face moved inwards off a non-periodic boundary.
+    /// The trilinear weights of component `axis` at `x` ([`face_stencil`], the interpolation's own), each face
+    /// moved inwards off a non-periodic boundary.
     fn weights(&self, axis: usize, x: &Vec3, out: &mut Vec<(usize, f64)>) {
         out.clear();
         let grid = &self.grid;
-        let dims = grid.face_dims(axis);
-        let mut lo = [0usize; 3];
-        let mut hi = [0usize; 3];
-        let mut w = [0.0f64; 3];
-        for a in 0..3 {
-            let offset = if a == axis { 0.0 } else { 0.5 };
-            let s = (x[a] - grid.origin_m[a]) / grid.h_m[a] - offset;
-            let base = s.floor();
-            let frac = s - base;
-            let base = base as isize;
-            if grid.periodic(a) {
-                let n = grid.n[a] as isize;
-                (lo[a], hi[a], w[a]) = (base.rem_euclid(n) as usize, (base + 1).rem_euclid(n) as usize, frac);
-            } else {
-                let max = dims[a] as isize - 1;
-                (lo[a], hi[a], w[a]) = if base < 0 {
-                    (0, 0, 0.0)
-                } else if base >= max {
-                    (max as usize, max as usize, 0.0)
-                } else {
-                    (base as usize, base as usize + 1, frac)
-                };
-            }
-        }
-        for corner in 0..8 {
-            let mut idx = [0usize; 3];
-            let mut weight = 1.0;
-            for a in 0..3 {
-                let upper = corner >> a & 1 == 1;
-                idx[a] = if upper { hi[a] } else { lo[a] };
-                weight *= if upper { w[a] } else { 1.0 - w[a] };
-            }
-            if weight == 0.0 {
-                continue;
-            }
+        let (stencil, count) = face_stencil(grid, axis, x);
+        for &(mut idx, weight) in &stencil[..count] {
             if !grid.periodic(axis) && grid.n[axis] > 1 {
                 idx[axis] = idx[axis].clamp(1, grid.n[axis] - 1);
             }
