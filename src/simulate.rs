@@ -47,6 +47,10 @@ pub struct Summary {
     pub checkpoints_written: u64,
     pub steps_per_s: f64,
     pub resumed_from_step: Option<u64>,
+    /// This invocation's wall time per engine stage, seconds (see `Simulation::stage_timings`).
+    pub stage_timings_s: Vec<(String, f64)>,
+    /// Neighbour-list builds in this invocation.
+    pub neighbor_builds: u64,
 }
 
 const SERIES_HEADER: &str = "step,time_s,kinetic_energy_j,translational_kinetic_energy_j,bed_top_m,mean_height_m,pair_contacts,wall_contacts,mean_coordination";
@@ -439,6 +443,8 @@ pub fn run_in_dir(built: &BuiltScenario, out: &Path, ctl: RunControl) -> Result<
         checkpoints_written,
         steps_per_s: (sim.step - start_step) as f64 / wall.max(1e-9),
         resumed_from_step,
+        stage_timings_s: sim.stage_timings(),
+        neighbor_builds: sim.neighbor_builds(),
     };
     if summary.finished {
         let json = serde_json::to_string_pretty(&summary).expect("summary serialises");

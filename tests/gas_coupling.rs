@@ -53,6 +53,7 @@ time: {{ dt_s: 1.0e-4, end_time_s: 2.0 }}
         velocity_tolerance: 1e-6,
         linear_tolerance: 1e-10,
         max_linear_iterations: 1000,
+        pressure_solver: Default::default(),
         inlet_faces: Vec::new(),
         blocked: Vec::new(),
     };
@@ -231,9 +232,9 @@ fn cell_averaged_drag_gives_the_gas_exactly_what_the_particles_get() {
 }
 
 #[test]
-fn fluid_forces_on_a_pool_give_the_same_bits_as_on_one_thread() {
+fn fluid_forces_on_a_team_give_the_same_bits_as_on_one_thread() {
     let sim = settling(1);
-    let pool = rayon::ThreadPoolBuilder::new().num_threads(2).build().unwrap();
+    let team = granflow::engine::team::Team::new(2);
     for method in [DragVelocities::Instantaneous, DragVelocities::CellAveraged] {
         let mut serial = sim.gas.as_ref().unwrap().fluid.clone();
         serial.drag_velocities = method;
@@ -260,7 +261,7 @@ fn fluid_forces_on_a_pool_give_the_same_bits_as_on_one_thread() {
         let radii = vec![RADIUS; n];
         let (mut f1, mut f2) = (vec![Vec3::zeros(); n], vec![Vec3::zeros(); n]);
         serial.add_forces(&positions, &velocities, &radii, &mut f1, None);
-        parallel.add_forces(&positions, &velocities, &radii, &mut f2, Some(&pool));
+        parallel.add_forces(&positions, &velocities, &radii, &mut f2, Some(&team));
         assert!(f1.iter().zip(&f2).all(|(a, b)| a == b), "{method:?}: forces differ");
         for a in 0..3 {
             assert_eq!(serial.reaction_n_per_m3[a], parallel.reaction_n_per_m3[a], "{method:?}");

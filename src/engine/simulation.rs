@@ -20,9 +20,9 @@ use super::state::{RngState, SimState};
 use super::team::Team;
 use super::{NumericalError, Vec3};
 
-/// Below this many particles the fluid forces are computed on the calling thread (measured: 2400 particles, two
-/// threads through rayon were 1.7x slower than one).
-const PARALLEL_FLUID_FORCES_MIN_PARTICLES: usize = 20_000;
+/// Below this many particles the fluid forces are computed on the calling thread (a hand-over to the team costs a
+/// few µs).
+const PARALLEL_FLUID_FORCES_MIN_PARTICLES: usize = 1000;
 
 /// Steps after which the parallel ranges are rebalanced from measured times even without a neighbour-list build.
 const REBALANCE_EVERY_STEPS: u64 = 200;
@@ -190,6 +190,29 @@ impl Simulation {
         self.team.size()
     }
 
+    /// This invocation's wall time per engine stage, seconds, by name (what a job's `result.json` and a
+    /// simulation's `summary.json` report).
+    pub fn stage_timings(&self) -> Vec<(String, f64)> {
+        let gas_solve_s = self.gas.as_ref().map_or(0.0, |g| g.linear_solve_s);
+        vec![
+            ("dem_neighbor".into(), self.timers.neighbor.as_secs_f64()),
+            (
+                "dem_contact_forces".into(),
+                (self.timers.force - self.timers.fluid_forces).as_secs_f64(),
+            ),
+            (
+                "fluid_forces_on_particles".into(),
+                self.timers.fluid_forces.as_secs_f64(),
+            ),
+            ("dem_integrate".into(), self.timers.integrate.as_secs_f64()),
+            (
+                "gas_assembly_and_porosity".into(),
+                self.timers.gas.as_secs_f64() - gas_solve_s,
+            ),
+            ("gas_linear_solve".into(), gas_solve_s),
+        ]
+    }
+
     pub fn neighbor_builds(&self) -> u64 {
         self.list.builds
     }
@@ -330,10 +353,10 @@ impl Simulation {
             }
             let p = &mut self.particles;
             let t = Instant::now();
-            // Handing a step's fluid forces to the rayon pool costs a wake-up per step (tens of µs), more than the
-            // work of a few thousand particles: parallel only for large beds.
-            let pool = (self.team.size() > 1 && p.len() >= PARALLEL_FLUID_FORCES_MIN_PARTICLES).then_some(&*self.pool);
-            fluid.add_forces(&p.position_m, &p.velocity_m_per_s, &p.radius_m, &mut p.force_n, pool);
+            // On the force pass's team, whose helpers are still spinning from the previous step (a rayon pool's
+            // sleeping workers took tens of µs to wake, more than the work of a few thousand particles).
+            let team = (p.len() >= PARALLEL_FLUID_FORCES_MIN_PARTICLES).then_some(&self.team);
+            fluid.add_forces(&p.position_m, &p.velocity_m_per_s, &p.radius_m, &mut p.force_n, team);
             self.timers.fluid_forces += t.elapsed();
         }
         let kick = HalfKick {

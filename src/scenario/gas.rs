@@ -13,6 +13,7 @@ use crate::engine::gas::coupled::GasCoupling;
 use crate::engine::gas::coupling::PorosityMethod;
 use crate::engine::gas::fluid_forces::{DragCoupling, DragVelocities};
 use crate::engine::gas::grid::side;
+use crate::engine::gas::linsolve::PressureSolver;
 use crate::engine::gas::simple::InletFace;
 use crate::engine::gas::{Boundary, Convection, GasConfig, Grid};
 use crate::engine::models::drag::DragLaw;
@@ -156,6 +157,14 @@ pub struct GasSolverSpec {
     pub linear_tolerance: f64,
     #[serde(default = "d_linear_iter")]
     pub max_linear_iterations: usize,
+    /// `auto` (default: a banded direct factorisation on small grids, conjugate gradients otherwise), `direct` or
+    /// `conjugate_gradient`. Not written when `auto`, so existing job ids stay as they were.
+    #[serde(default, skip_serializing_if = "is_auto")]
+    pub pressure_solver: PressureSolver,
+}
+
+fn is_auto(s: &PressureSolver) -> bool {
+    *s == PressureSolver::Auto
 }
 
 fn d_relax_velocity() -> f64 {
@@ -190,6 +199,7 @@ impl Default for GasSolverSpec {
             velocity_tolerance: d_velocity_tol(),
             linear_tolerance: d_linear_tol(),
             max_linear_iterations: d_linear_iter(),
+            pressure_solver: PressureSolver::Auto,
         }
     }
 }
@@ -468,6 +478,7 @@ pub fn build_gas(
         velocity_tolerance: s.velocity_tolerance,
         linear_tolerance: s.linear_tolerance,
         max_linear_iterations: s.max_linear_iterations,
+        pressure_solver: s.pressure_solver,
         inlet_faces,
         blocked,
     };

@@ -155,30 +155,15 @@ fn run(opts: &WorkerOptions) -> Result<i32, Error> {
         format: RESULT_FORMAT,
         job_id: job.job_id.clone(),
         metrics,
-        timings: vec![
+        // This invocation's engine stages follow (after a resume, only the part since the resume).
+        timings: [
             ("simulate".into(), simulate_s),
             ("checkpoint".into(), summary.checkpoint_time_s),
             ("reduce".into(), reduce_s),
-            // This invocation's engine stages (after a resume, only the part since the resume).
-            ("dem_neighbor".into(), sim.timers.neighbor.as_secs_f64()),
-            (
-                "dem_contact_forces".into(),
-                (sim.timers.force - sim.timers.fluid_forces).as_secs_f64(),
-            ),
-            (
-                "fluid_forces_on_particles".into(),
-                sim.timers.fluid_forces.as_secs_f64(),
-            ),
-            ("dem_integrate".into(), sim.timers.integrate.as_secs_f64()),
-            ("gas_assembly_and_porosity".into(), {
-                let solve = sim.gas.as_ref().map_or(0.0, |g| g.linear_solve_s);
-                sim.timers.gas.as_secs_f64() - solve
-            }),
-            (
-                "gas_linear_solve".into(),
-                sim.gas.as_ref().map_or(0.0, |g| g.linear_solve_s),
-            ),
-        ],
+        ]
+        .into_iter()
+        .chain(sim.stage_timings())
+        .collect(),
         steps: sim.step,
         sim_time_s: sim.time_s,
         wall_time_s: start.elapsed().as_secs_f64(),

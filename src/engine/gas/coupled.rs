@@ -14,6 +14,12 @@ use super::simple::{GasConfig, GasSolver};
 use crate::engine::Vec3;
 use crate::engine::models::drag::DragLaw;
 
+/// How many times a failed gas step is retried with halved under-relaxation.
+pub const GAS_STEP_RETRIES: u32 = 2;
+
+/// A gas step that ends with a mass imbalance above this many times its tolerance has failed.
+pub const RETRY_IMBALANCE_FACTOR: f64 = 100.0;
+
 /// How the last gas step went (kept in the checkpoint so a resumed run reports the same series).
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct GasStepStats {
@@ -115,29 +121,79 @@ impl GasCoupling {
         for (a, s) in source.iter_mut().enumerate() {
             s.iter_mut().for_each(|v| *v += self.gas_body_force_n_per_m3[a]);
         }
-        let report = self.solver.step(dt_s, &source, &sink, &old_porosity);
-        self.linear_solve_s += report.linear_solve_s;
-        let state = &self.solver.state;
-        if let Some(k) = state.pressure_pa.iter().position(|p| !p.is_finite()) {
-            return Err(format!("gas pressure of cell {k} is not finite"));
-        }
-        for (a, v) in state.velocity_m_per_s.iter().enumerate() {
-            if let Some(k) = v.iter().position(|u| !u.is_finite()) {
-                return Err(format!("gas velocity component {a} of face {k} is not finite"));
+        // A step that fails (its field stops being finite, or it ends with a mass imbalance above
+        // RETRY_IMBALANCE_FACTOR × the tolerance) is taken again from the same start with halved under-relaxation
+        // and twice the outer iterations, up to GAS_STEP_RETRIES times (the same inputs give the same retries:
+        // restarts stay exact). A step that merely stops short of a tight tolerance is kept. Iteration counts add
+        // up over the attempts.
+        let start = (
+            self.solver.state.velocity_m_per_s.clone(),
+            self.solver.state.pressure_pa.clone(),
+            self.solver.state.time_s,
+        );
+        let configured = self.solver.config.clone();
+        let (mut outer_iterations, mut linear_iterations) = (0, 0);
+        let mut report = None;
+        for attempt in 0..=GAS_STEP_RETRIES {
+            if attempt > 0 {
+                let damping = 0.5f64.powi(attempt as i32);
+                let config = &mut self.solver.config;
+                config.relax_velocity = configured.relax_velocity * damping;
+                config.relax_pressure = configured.relax_pressure * damping;
+                config.max_outer_iterations = configured.max_outer_iterations << attempt;
+                let state = &mut self.solver.state;
+                state.velocity_m_per_s.clone_from(&start.0);
+                state.pressure_pa.clone_from(&start.1);
+                state.time_s = start.2;
+                tracing::debug!(
+                    time_s = start.2,
+                    attempt,
+                    "gas step did not converge; retrying with under-relaxation x{damping}"
+                );
+            }
+            let r = self.solver.step(dt_s, &source, &sink, &old_porosity);
+            self.linear_solve_s += r.linear_solve_s;
+            outer_iterations += r.outer_iterations as u64;
+            linear_iterations += (r.momentum.iterations + r.pressure.iterations) as u64;
+            report = Some(r);
+            let failed = self.non_finite().is_some()
+                || (!r.converged && r.mass_imbalance > RETRY_IMBALANCE_FACTOR * configured.mass_tolerance);
+            if !failed {
+                break;
             }
         }
+        self.solver.config = configured;
+        let report = report.expect("at least one attempt");
+        if let Some(what) = self.non_finite() {
+            return Err(what);
+        }
+        let state = &self.solver.state;
         self.fluid.freeze(
             &self.solver.interstitial_velocity_m_per_s(),
             &state.pressure_pa,
             &state.porosity,
         );
         self.last = GasStepStats {
-            outer_iterations: report.outer_iterations as u64,
-            linear_iterations: (report.momentum.iterations + report.pressure.iterations) as u64,
+            outer_iterations,
+            linear_iterations,
             mass_imbalance: report.mass_imbalance,
             converged: report.converged,
         };
         Ok(self.last)
+    }
+
+    /// Names the first non-finite gas quantity, if any.
+    fn non_finite(&self) -> Option<String> {
+        let state = &self.solver.state;
+        if let Some(k) = state.pressure_pa.iter().position(|p| !p.is_finite()) {
+            return Some(format!("gas pressure of cell {k} is not finite"));
+        }
+        for (a, v) in state.velocity_m_per_s.iter().enumerate() {
+            if let Some(k) = v.iter().position(|u| !u.is_finite()) {
+                return Some(format!("gas velocity component {a} of face {k} is not finite"));
+            }
+        }
+        None
     }
 
     pub fn snapshot(&self) -> GasSnapshot {

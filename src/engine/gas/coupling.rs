@@ -113,62 +113,136 @@ pub fn porosity(grid: &Grid, method: PorosityMethod, positions_m: &[Vec3], radii
         .collect()
 }
 
-/// The trilinear stencil of the component along `axis` at `x`: up to 8 (face index, weight) pairs with non-zero
-/// weight, in corner order (faces sit at i·h along their axis and at cell centres across it; clamped at
-/// non-periodic edges, wrapped on periodic axes). Shared by interpolation and by the spreading of the drag reaction,
-/// so both use the same weights.
-pub fn face_stencil(grid: &Grid, axis: usize, x: &Vec3) -> ([([usize; 3], f64); 8], usize) {
-    let dims = grid.face_dims(axis);
-    let mut lo = [0usize; 3];
-    let mut hi = [0usize; 3];
-    let mut w = [0.0f64; 3];
-    for a in 0..3 {
-        let offset = if a == axis { 0.0 } else { 0.5 };
-        let s = (x[a] - grid.origin_m[a]) / grid.h_m[a] - offset;
-        let base = s.floor();
-        let frac = s - base;
-        let base = base as isize;
-        if grid.periodic(a) {
-            let n = grid.n[a] as isize;
-            (lo[a], hi[a], w[a]) = (base.rem_euclid(n) as usize, (base + 1).rem_euclid(n) as usize, frac);
-        } else {
-            let max = dims[a] as isize - 1;
-            (lo[a], hi[a], w[a]) = if base < 0 {
-                (0, 0, 0.0)
-            } else if base >= max {
-                (max as usize, max as usize, 0.0)
-            } else {
-                (base as usize, base as usize + 1, frac)
-            };
+/// The lattice of one velocity component's faces (faces sit at i·h along their axis and at cell centres across
+/// it), precomputed for fast trilinear stencils: interpolation and the spreading of the drag reaction use the same
+/// weights.
+#[derive(Debug, Clone, Copy)]
+pub struct FaceLattice {
+    axis: usize,
+    dims: [usize; 3],
+    stride: [usize; 3],
+    origin_m: [f64; 3],
+    inverse_h_per_m: [f64; 3],
+    /// 0 along the axis, ½ across it (in cells).
+    offset: [f64; 3],
+    periodic: [bool; 3],
+}
+
+/// Up to 8 faces (flat indices into the component's array) with non-zero trilinear weights, in corner order.
+#[derive(Debug, Clone, Copy)]
+pub struct Stencil {
+    pub face: [usize; 8],
+    pub weight: [f64; 8],
+    pub count: usize,
+}
+
+impl Stencil {
+    /// Σ w · values[face].
+    #[inline]
+    pub fn apply(&self, values: &[f64]) -> f64 {
+        let mut sum = 0.0;
+        for c in 0..self.count {
+            sum += self.weight[c] * values[self.face[c]];
+        }
+        sum
+    }
+}
+
+impl FaceLattice {
+    pub fn new(grid: &Grid, axis: usize) -> Self {
+        let dims = grid.face_dims(axis);
+        FaceLattice {
+            axis,
+            dims,
+            stride: [1, dims[0], dims[0] * dims[1]],
+            origin_m: grid.origin_m,
+            inverse_h_per_m: std::array::from_fn(|a| 1.0 / grid.h_m[a]),
+            offset: std::array::from_fn(|a| if a == axis { 0.0 } else { 0.5 }),
+            periodic: std::array::from_fn(|a| grid.periodic(a)),
         }
     }
-    let mut out = [([0usize; 3], 0.0); 8];
-    let mut count = 0;
-    for corner in 0..8 {
-        let mut idx = [0usize; 3];
-        let mut weight = 1.0;
+
+    /// The trilinear stencil at `x`: clamped at non-periodic edges (a point beyond the last face takes that face),
+    /// wrapped on periodic axes. With `inward`, faces on a non-periodic boundary of the component's own axis are
+    /// replaced by the next face inwards (how the drag reaction keeps its boundary share inside the gas).
+    #[inline]
+    pub fn stencil(&self, x: &Vec3, inward: bool) -> Stencil {
+        let mut lo = [0usize; 3];
+        let mut hi = [0usize; 3];
+        let mut w = [0.0f64; 3];
         for a in 0..3 {
-            let upper = corner >> a & 1 == 1;
-            idx[a] = if upper { hi[a] } else { lo[a] };
-            weight *= if upper { w[a] } else { 1.0 - w[a] };
+            let s = (x[a] - self.origin_m[a]) * self.inverse_h_per_m[a] - self.offset[a];
+            let base = s.floor();
+            let frac = s - base;
+            let base = base as isize;
+            if self.periodic[a] {
+                // Faces across a periodic axis number n (the high side is the low side).
+                let n = self.dims[a] as isize - isize::from(a == self.axis);
+                (lo[a], hi[a], w[a]) = (wrap(base, n), wrap(base + 1, n), frac);
+            } else {
+                let max = self.dims[a] as isize - 1;
+                (lo[a], hi[a], w[a]) = if base < 0 {
+                    (0, 0, 0.0)
+                } else if base >= max {
+                    (max as usize, max as usize, 0.0)
+                } else {
+                    (base as usize, base as usize + 1, frac)
+                };
+                if inward && a == self.axis && max >= 2 {
+                    let m = max as usize - 1;
+                    lo[a] = lo[a].clamp(1, m);
+                    hi[a] = hi[a].clamp(1, m);
+                }
+            }
         }
-        if weight != 0.0 {
-            out[count] = (idx, weight);
-            count += 1;
+        let mut out = Stencil {
+            face: [0; 8],
+            weight: [0.0; 8],
+            count: 0,
+        };
+        for corner in 0..8 {
+            let mut face = 0;
+            let mut weight = 1.0;
+            for a in 0..3 {
+                let upper = corner >> a & 1 == 1;
+                face += self.stride[a] * if upper { hi[a] } else { lo[a] };
+                weight *= if upper { w[a] } else { 1.0 - w[a] };
+            }
+            if weight != 0.0 {
+                out.face[out.count] = face;
+                out.weight[out.count] = weight;
+                out.count += 1;
+            }
         }
+        out
     }
-    (out, count)
+
+    /// The component's value at `x` from its face values.
+    #[inline]
+    pub fn interpolate(&self, values: &[f64], x: &Vec3) -> f64 {
+        self.stencil(x, false).apply(values)
+    }
+}
+
+/// `i` wrapped into [0, n) (positions on a periodic axis are within one period of the domain, so the division is
+/// rarely needed).
+#[inline]
+fn wrap(i: isize, n: isize) -> usize {
+    if (0..n).contains(&i) {
+        i as usize
+    } else if (n..2 * n).contains(&i) {
+        (i - n) as usize
+    } else if (-n..0).contains(&i) {
+        (i + n) as usize
+    } else {
+        i.rem_euclid(n) as usize
+    }
 }
 
 /// One velocity component at a point: trilinear interpolation between the component's face values
-/// ([`face_stencil`]).
+/// ([`FaceLattice`]).
 pub fn interpolate_component(grid: &Grid, values: &[f64], axis: usize, x: &Vec3) -> f64 {
-    let (stencil, count) = face_stencil(grid, axis, x);
-    let mut sum = 0.0;
-    for &(idx, weight) in &stencil[..count] {
-        sum += weight * values[grid.face(axis, idx)];
-    }
-    sum
+    FaceLattice::new(grid, axis).interpolate(values, x)
 }
 
 /// The gas velocity at a point (the z component is 0 on a 2-D grid).

@@ -11,10 +11,11 @@ use std::f64::consts::PI;
 
 use serde::{Deserialize, Serialize};
 
-use super::coupling::{face_stencil, interpolate_component};
+use super::coupling::FaceLattice;
 use super::grid::Grid;
 use crate::engine::Vec3;
 use crate::engine::models::drag::{DragInput, DragLaw};
+use crate::engine::team::Team;
 
 /// How the gas receives the drag (the particles always get K (u − v) under the frozen field).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize, schemars::JsonSchema)]
@@ -44,22 +45,29 @@ pub enum DragVelocities {
 /// Each particle's drag record of one step.
 type DragRecord = (Vec3, f64, Vec3);
 
-/// Runs `compute` for every particle (index, its drag record, its force), on `pool` when given. Particles are
-/// independent, so the result is the same on any thread count.
-fn per_particle<F>(pool: Option<&rayon::ThreadPool>, drag: &mut [DragRecord], force: &mut [Vec3], compute: F)
+/// Runs `compute` for every particle (index, its drag record, its force), on `team` when given (a few contiguous
+/// blocks of particles per thread). Particles are independent, so the result is the same on any thread count.
+fn per_particle<F>(team: Option<&Team>, drag: &mut [DragRecord], force: &mut [Vec3], compute: F)
 where
     F: Fn((usize, (&mut DragRecord, &mut Vec3))) + Sync + Send,
 {
-    match pool {
-        Some(pool) => pool.install(|| {
-            use rayon::prelude::*;
-            drag.par_iter_mut()
-                .zip(force.par_iter_mut())
+    match team {
+        Some(team) if team.size() > 1 => {
+            let block = drag.len().div_ceil(4 * team.size()).max(1);
+            let parts: Vec<(usize, &mut [DragRecord], &mut [Vec3])> = drag
+                .chunks_mut(block)
+                .zip(force.chunks_mut(block))
                 .enumerate()
-                .with_min_len(256)
-                .for_each(compute)
-        }),
-        None => drag.iter_mut().zip(force.iter_mut()).enumerate().for_each(compute),
+                .map(|(k, (d, f))| (k * block, d, f))
+                .collect();
+            team.map_parts(parts, |_, (start, d, f)| {
+                d.iter_mut()
+                    .zip(f.iter_mut())
+                    .enumerate()
+                    .for_each(|(i, pair)| compute((start + i, pair)))
+            });
+        }
+        _ => drag.iter_mut().zip(force.iter_mut()).enumerate().for_each(compute),
     }
 }
 
@@ -84,8 +92,29 @@ pub struct FluidForces {
     /// Σ over DEM steps of w K v / V_cell at each face (v the particle velocity the drag used), N/m³: its +β v.
     pub beta_velocity_sum: [Vec<f64>; 3],
     pub steps: u32,
-    /// Workspace: each particle's drag of the current step, its coefficient K and the particle velocity used.
-    drag_buffer: Vec<DragRecord>,
+    /// The trilinear lattices of the three velocity components (built from `grid`).
+    lattice: [FaceLattice; 3],
+    inverse_h_per_m: [f64; 3],
+    periodic: [bool; 3],
+    workspace: Workspace,
+}
+
+/// Per-step scratch arrays, kept between steps to avoid allocations.
+#[derive(Debug, Clone, Default)]
+struct Workspace {
+    /// Each particle's drag of the current step, its coefficient K and the particle velocity used.
+    drag: Vec<DragRecord>,
+    /// Each particle's cell.
+    cell: Vec<usize>,
+    /// Per cell (cell-averaged drag): particle volume, Σ V v, the slip, K of the first particle's radius, Σ drag,
+    /// Σ K; and the occupied cells in order of first occupation.
+    solid_volume_m3: Vec<f64>,
+    momentum: Vec<Vec3>,
+    slip_m_per_s: Vec<Vec3>,
+    reference_k: Vec<(f64, f64)>,
+    drag_sum_n: Vec<Vec3>,
+    k_sum_n_s_per_m: Vec<f64>,
+    occupied: Vec<usize>,
 }
 
 impl FluidForces {
@@ -99,7 +128,10 @@ impl FluidForces {
             beta_velocity_sum: zeros(&grid),
             porosity: vec![1.0; grid.cells()],
             steps: 0,
-            drag_buffer: Vec::new(),
+            lattice: std::array::from_fn(|a| FaceLattice::new(&grid, a)),
+            inverse_h_per_m: std::array::from_fn(|a| 1.0 / grid.h_m[a]),
+            periodic: std::array::from_fn(|a| grid.periodic(a)),
+            workspace: Workspace::default(),
             grid,
             drag,
             drag_velocities: DragVelocities::Instantaneous,
@@ -151,32 +183,26 @@ impl FluidForces {
         self.steps = 0;
     }
 
-    /// The trilinear weights of component `axis` at `x` ([`face_stencil`], the interpolation's own), each face
-    /// moved inwards off a non-periodic boundary.
-    fn weights(&self, axis: usize, x: &Vec3, out: &mut Vec<(usize, f64)>) {
-        out.clear();
+    /// The cell holding `x` (clamped into a non-periodic grid, wrapped on a periodic axis), as a flat index.
+    fn cell_of(&self, x: &Vec3) -> usize {
         let grid = &self.grid;
-        let (stencil, count) = face_stencil(grid, axis, x);
-        for &(mut idx, weight) in &stencil[..count] {
-            if !grid.periodic(axis) && grid.n[axis] > 1 {
-                idx[axis] = idx[axis].clamp(1, grid.n[axis] - 1);
-            }
-            out.push((grid.face(axis, idx), weight));
-        }
-    }
-
-    /// The cell holding `x` (clamped into a non-periodic grid, wrapped on a periodic axis).
-    fn cell_of(&self, x: &Vec3) -> [usize; 3] {
-        let grid = &self.grid;
-        std::array::from_fn(|a| {
-            let c = ((x[a] - grid.origin_m[a]) / grid.h_m[a]).floor() as isize;
+        grid.cell(std::array::from_fn(|a| {
+            let c = ((x[a] - grid.origin_m[a]) * self.inverse_h_per_m[a]).floor() as isize;
             let n = grid.n[a] as isize;
-            if grid.periodic(a) {
+            if (0..n).contains(&c) {
+                c as usize
+            } else if self.periodic[a] {
                 c.rem_euclid(n) as usize
             } else {
                 c.clamp(0, n - 1) as usize
             }
-        })
+        }))
+    }
+
+    /// The cell's index triple from its flat index.
+    fn cell_indices(&self, c: usize) -> [usize; 3] {
+        let n = self.grid.n;
+        [c % n[0], (c / n[0]) % n[1], c / (n[0] * n[1])]
     }
 
     /// The faces bounding cell `c` along `axis` (low, high), moved inwards off a non-periodic boundary.
@@ -211,24 +237,34 @@ impl FluidForces {
     }
 
     /// Adds the gas's force on each particle to `force` and accumulates the reaction on the gas for one DEM step.
-    /// With a pool, the per-particle forces of the instantaneous method are computed on it (same bits).
+    /// With a team, the per-particle forces are computed on it (same bits: the reaction is summed serially).
     pub fn add_forces(
         &mut self,
         positions_m: &[Vec3],
         velocities_m_per_s: &[Vec3],
         radii_m: &[f64],
         force: &mut [Vec3],
-        pool: Option<&rayon::ThreadPool>,
+        team: Option<&Team>,
     ) {
         match self.drag_velocities {
             DragVelocities::Instantaneous => {
-                self.add_forces_instantaneous(positions_m, velocities_m_per_s, radii_m, force, pool)
+                self.add_forces_instantaneous(positions_m, velocities_m_per_s, radii_m, force, team)
             }
             DragVelocities::CellAveraged => {
-                self.add_forces_cell_averaged(positions_m, velocities_m_per_s, radii_m, force, pool)
+                self.add_forces_cell_averaged(positions_m, velocities_m_per_s, radii_m, force, team)
             }
         }
         self.steps += 1;
+    }
+
+    /// −∇p interpolated to `x`.
+    #[inline]
+    fn minus_pressure_gradient_at(&self, x: &Vec3) -> Vec3 {
+        let mut grad = Vec3::zeros();
+        for a in 0..self.grid.axes() {
+            grad[a] = self.lattice[a].interpolate(&self.minus_pressure_gradient_pa_per_m[a], x);
+        }
+        grad
     }
 
     fn add_forces_cell_averaged(
@@ -237,64 +273,80 @@ impl FluidForces {
         velocities_m_per_s: &[Vec3],
         radii_m: &[f64],
         force: &mut [Vec3],
-        pool: Option<&rayon::ThreadPool>,
+        team: Option<&Team>,
     ) {
-        let grid = self.grid.clone();
-        let cells: Vec<usize> = positions_m.iter().map(|x| grid.cell(self.cell_of(x))).collect();
+        let mut ws = std::mem::take(&mut self.workspace);
+        let cells = self.grid.cells();
+        ws.cell.clear();
+        ws.cell.extend(positions_m.iter().map(|x| self.cell_of(x)));
+        ws.solid_volume_m3.resize(cells, 0.0);
+        ws.momentum.resize(cells, Vec3::zeros());
+        ws.slip_m_per_s.resize(cells, Vec3::zeros());
+        ws.reference_k.resize(cells, (0.0, 0.0));
+        ws.drag_sum_n.resize(cells, Vec3::zeros());
+        ws.k_sum_n_s_per_m.resize(cells, 0.0);
         // Volume-weighted mean particle velocity per cell (seed 002 eq 35), serially in particle order.
-        let mut volume = vec![0.0; grid.cells()];
-        let mut momentum = vec![Vec3::zeros(); grid.cells()];
-        for i in 0..positions_m.len() {
+        ws.occupied.clear();
+        for (i, &c) in ws.cell.iter().enumerate() {
             let v = 4.0 / 3.0 * PI * radii_m[i].powi(3);
-            volume[cells[i]] += v;
-            momentum[cells[i]] += velocities_m_per_s[i] * v;
-        }
-        // Per occupied cell: v_sm, the slip, and K for the diameter of the cell's first particle (every particle
-        // of that diameter in the cell has the same K, so the drag law runs once per cell for a monodisperse bed).
-        let mut slip_of_cell = vec![Vec3::zeros(); grid.cells()];
-        let mut k_of_cell = vec![(f64::NAN, 0.0); grid.cells()];
-        for i in 0..positions_m.len() {
-            let c = cells[i];
-            if k_of_cell[c].0.is_nan() {
-                let slip = self.cell_gas_velocity(self.cell_of(&positions_m[i])) - momentum[c] / volume[c];
-                slip_of_cell[c] = slip;
-                k_of_cell[c] = (radii_m[i], self.cell_drag_coefficient(c, &slip, radii_m[i]));
+            if ws.solid_volume_m3[c] == 0.0 {
+                ws.occupied.push(c);
+                ws.momentum[c] = Vec3::zeros();
+                ws.drag_sum_n[c] = Vec3::zeros();
+                ws.k_sum_n_s_per_m[c] = 0.0;
+                // K for the diameter of the cell's first particle: every particle of that diameter in the cell has
+                // the same K, so the drag law runs once per cell for a monodisperse bed.
+                ws.reference_k[c].0 = radii_m[i];
             }
+            ws.solid_volume_m3[c] += v;
+            ws.momentum[c] += velocities_m_per_s[i] * v;
         }
-        let mut drag = std::mem::take(&mut self.drag_buffer);
+        // Per occupied cell: the slip between the gas at the cell centre and v_sm, and K.
+        for &c in &ws.occupied {
+            let v_sm = ws.momentum[c] / ws.solid_volume_m3[c];
+            let slip = self.cell_gas_velocity(self.cell_indices(c)) - v_sm;
+            ws.slip_m_per_s[c] = slip;
+            ws.momentum[c] = v_sm;
+            ws.reference_k[c].1 = self.cell_drag_coefficient(c, &slip, ws.reference_k[c].0);
+        }
+        let mut drag = std::mem::take(&mut ws.drag);
         drag.resize(positions_m.len(), (Vec3::zeros(), 0.0, Vec3::zeros()));
-        let this = &*self;
+        let (this, ws_ref) = (&*self, &ws);
         let compute = |(i, (d, f)): (usize, (&mut DragRecord, &mut Vec3))| {
-            let x = &positions_m[i];
-            let k_cell = cells[i];
-            let v_sm = momentum[k_cell] / volume[k_cell];
-            let slip = slip_of_cell[k_cell];
-            let (r_ref, k_ref) = k_of_cell[k_cell];
+            let c = ws_ref.cell[i];
+            let slip = ws_ref.slip_m_per_s[c];
+            let (r_ref, k_ref) = ws_ref.reference_k[c];
             let k = if radii_m[i] == r_ref {
                 k_ref
             } else {
-                this.cell_drag_coefficient(k_cell, &slip, radii_m[i])
+                this.cell_drag_coefficient(c, &slip, radii_m[i])
             };
-            let mut grad = Vec3::zeros();
-            for a in 0..grid.axes() {
-                grad[a] = interpolate_component(&grid, &this.minus_pressure_gradient_pa_per_m[a], a, x);
-            }
-            *d = (slip * k, k, v_sm);
+            let grad = this.minus_pressure_gradient_at(&positions_m[i]);
+            *d = (slip * k, k, ws_ref.momentum[c]);
             *f += d.0 + grad * (4.0 / 3.0 * PI * radii_m[i].powi(3));
         };
-        per_particle(pool, &mut drag, force, compute);
-        let cell_volume = grid.cell_volume_m3();
-        for (x, (d, k, v)) in positions_m.iter().zip(&drag) {
-            let c = self.cell_of(x);
-            for a in 0..grid.axes() {
-                for face in self.cell_faces(c, a) {
-                    self.reaction_n_per_m3[a][face] -= 0.5 * d[a] / cell_volume;
-                    self.beta_sum[a][face] += 0.5 * k / cell_volume;
-                    self.beta_velocity_sum[a][face] += 0.5 * k * v[a] / cell_volume;
+        per_particle(team, &mut drag, force, compute);
+        // The reaction per cell (serially in particle order), then half of it to each of the cell's two faces
+        // along each axis.
+        for (&c, (d, k, _)) in ws.cell.iter().zip(&drag) {
+            ws.drag_sum_n[c] += d;
+            ws.k_sum_n_s_per_m[c] += k;
+        }
+        let half_per_volume = 0.5 / self.grid.cell_volume_m3();
+        for &c in &ws.occupied {
+            let (d, k, v_sm) = (ws.drag_sum_n[c], ws.k_sum_n_s_per_m[c], ws.momentum[c]);
+            let idx = self.cell_indices(c);
+            for a in 0..self.grid.axes() {
+                for face in self.cell_faces(idx, a) {
+                    self.reaction_n_per_m3[a][face] -= half_per_volume * d[a];
+                    self.beta_sum[a][face] += half_per_volume * k;
+                    self.beta_velocity_sum[a][face] += half_per_volume * k * v_sm[a];
                 }
             }
+            ws.solid_volume_m3[c] = 0.0;
         }
-        self.drag_buffer = drag;
+        ws.drag = drag;
+        self.workspace = ws;
     }
 
     /// K of a particle of radius `r` in cell `c` at slip `slip` (the cell-averaged method).
@@ -310,14 +362,14 @@ impl FluidForces {
 
     /// The drag, its coefficient K and the total fluid force on particle i (instantaneous velocities).
     fn instantaneous_force(&self, x: &Vec3, v: &Vec3, r: f64) -> (Vec3, f64, Vec3) {
-        let grid = &self.grid;
         let volume = 4.0 / 3.0 * PI * r * r * r;
-        let eps = self.porosity[grid.cell(self.cell_of(x))];
+        let eps = self.porosity[self.cell_of(x)];
         let mut u = Vec3::zeros();
         let mut grad = Vec3::zeros();
-        for a in 0..grid.axes() {
-            u[a] = interpolate_component(grid, &self.velocity_m_per_s[a], a, x);
-            grad[a] = interpolate_component(grid, &self.minus_pressure_gradient_pa_per_m[a], a, x);
+        for a in 0..self.grid.axes() {
+            let stencil = self.lattice[a].stencil(x, false);
+            u[a] = stencil.apply(&self.velocity_m_per_s[a]);
+            grad[a] = stencil.apply(&self.minus_pressure_gradient_pa_per_m[a]);
         }
         let slip = u - v;
         let k = self.drag.coefficient_n_s_per_m(&DragInput {
@@ -337,11 +389,11 @@ impl FluidForces {
         velocities_m_per_s: &[Vec3],
         radii_m: &[f64],
         force: &mut [Vec3],
-        pool: Option<&rayon::ThreadPool>,
+        team: Option<&Team>,
     ) {
         // Per-particle forces are independent (any thread count gives the same bits); the reaction is then
-        // scattered serially in particle order.
-        let mut drag = std::mem::take(&mut self.drag_buffer);
+        // scattered serially in particle order, with the interpolation's weights (boundary faces moved inwards).
+        let mut drag = std::mem::take(&mut self.workspace.drag);
         drag.resize(positions_m.len(), (Vec3::zeros(), 0.0, Vec3::zeros()));
         let this = &*self;
         let compute = |(i, (d, f)): (usize, (&mut DragRecord, &mut Vec3))| {
@@ -349,20 +401,25 @@ impl FluidForces {
             *d = (dr, k, velocities_m_per_s[i]);
             *f += total;
         };
-        per_particle(pool, &mut drag, force, compute);
-        let cell_volume = self.grid.cell_volume_m3();
-        let mut weights = Vec::with_capacity(8);
+        per_particle(team, &mut drag, force, compute);
+        let per_volume = 1.0 / self.grid.cell_volume_m3();
         for (x, (d, k, v)) in positions_m.iter().zip(&drag) {
             for a in 0..self.grid.axes() {
-                self.weights(a, x, &mut weights);
-                for &(face, w) in &weights {
-                    self.reaction_n_per_m3[a][face] -= w * d[a] / cell_volume;
-                    self.beta_sum[a][face] += w * k / cell_volume;
-                    self.beta_velocity_sum[a][face] += w * k * v[a] / cell_volume;
+                let stencil = self.lattice[a].stencil(x, true);
+                let (reaction, beta, beta_v) = (
+                    &mut self.reaction_n_per_m3[a],
+                    &mut self.beta_sum[a],
+                    &mut self.beta_velocity_sum[a],
+                );
+                for c in 0..stencil.count {
+                    let (face, w) = (stencil.face[c], stencil.weight[c] * per_volume);
+                    reaction[face] -= w * d[a];
+                    beta[face] += w * k;
+                    beta_v[face] += w * k * v[a];
                 }
             }
         }
-        self.drag_buffer = drag;
+        self.workspace.drag = drag;
     }
 
     /// The mean reaction per unit volume over the DEM steps since the last freeze (the gas's momentum source).

@@ -16,7 +16,9 @@
 use serde::{Deserialize, Serialize};
 
 use super::grid::{Boundary, Grid, side};
-use super::linsolve::{NONE, SolveReport, StencilSystem, bicgstab, conjugate_gradient};
+use super::linsolve::{
+    NONE, PressureSolver, SolveReport, StencilSystem, bandwidth, bicgstab, conjugate_gradient, direct_symmetric,
+};
 
 /// The convection scheme.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, schemars::JsonSchema)]
@@ -45,6 +47,8 @@ pub struct GasConfig {
     pub velocity_tolerance: f64,
     pub linear_tolerance: f64,
     pub max_linear_iterations: usize,
+    /// How the pressure corrections are solved.
+    pub pressure_solver: PressureSolver,
     /// Boundary faces through which gas enters at their own velocity (jets through chosen distributor cells),
     /// overriding what their side says.
     pub inlet_faces: Vec<InletFace>,
@@ -227,10 +231,15 @@ impl GasSolver {
                     self.state.velocity_m_per_s[a][f] = match b {
                         Boundary::Inlet { velocity_m_per_s } => velocity_m_per_s[a],
                         Boundary::Outlet if grid.n[a] > 1 => {
-                            // Zero gradient: the next face inwards.
+                            // Zero gradient from the next face inwards, but never inflow: a face where the copy would
+                            // point into the domain is closed (OpenFOAM's inletOutlet). Copying a return flow and then
+                            // scaling the outlet up to the needed outflow amplifies it from one outer iteration to
+                            // the next until the step diverges (seen in a jet bed's freeboard).
                             let mut inner = idx;
                             inner[a] = if along == 0 { 1 } else { grid.n[a] - 1 };
-                            self.state.velocity_m_per_s[a][grid.face(a, inner)]
+                            let u = self.state.velocity_m_per_s[a][grid.face(a, inner)];
+                            let outward = if along == 0 { -u } else { u };
+                            if outward > 0.0 { u } else { 0.0 }
                         }
                         _ => 0.0,
                     };
@@ -605,13 +614,17 @@ impl GasSolver {
             }
             let mut pc = vec![0.0; psys.len()];
             let t = std::time::Instant::now();
-            let r = conjugate_gradient(
-                &psys,
-                &mut pc,
-                self.config.linear_tolerance,
-                self.config.max_linear_iterations,
-                true,
-            );
+            let r = if self.config.pressure_solver.direct_for(psys.len(), bandwidth(&psys)) {
+                direct_symmetric(&psys, &mut pc, true)
+            } else {
+                conjugate_gradient(
+                    &psys,
+                    &mut pc,
+                    self.config.linear_tolerance,
+                    self.config.max_linear_iterations,
+                    true,
+                )
+            };
             report.linear_solve_s += t.elapsed().as_secs_f64();
             report.pressure.iterations += r.iterations;
             report.pressure.relative_residual = report.pressure.relative_residual.max(r.relative_residual);
