@@ -154,7 +154,10 @@ impl NeighborList {
     }
 
     /// Rebuilds the lists for particles of radius `radius` at `position`. Pairs are candidates when their surfaces
-    /// are closer than `skin_m`; particle–wall pairs likewise.
+    /// are closer than `skin_m`; particle–wall pairs likewise, except that in a `pseudo_2d` run a plane normal to z
+    /// is a candidate only if the particle already overlaps it (its gap cannot change: in a one-layer bed every
+    /// particle just touches the front and back planes, which never push).
+    #[allow(clippy::too_many_arguments)]
     pub fn build(
         &mut self,
         domain: &Domain,
@@ -163,6 +166,7 @@ impl NeighborList {
         skin_m: f64,
         walls: &[Wall],
         wall_angle: &[f64],
+        pseudo_2d: bool,
     ) {
         let n = position.len();
         let max_radius = radius.iter().copied().fold(0.0, f64::max);
@@ -213,7 +217,12 @@ impl NeighborList {
                     out.counts.push((out.partners.len() - before) as u32);
                     let walls_before = out.walls.len();
                     for (w, wall) in walls.iter().enumerate() {
-                        if wall.proximity(&xi, wall_angle[w]).gap_m < ri + skin_m {
+                        let reach = if pseudo_2d && wall.is_plane_normal_to_z() {
+                            ri
+                        } else {
+                            ri + skin_m
+                        };
+                        if wall.proximity(&xi, wall_angle[w]).gap_m < reach {
                             out.walls.push(w as u16);
                         }
                     }
@@ -288,7 +297,7 @@ mod tests {
                 .collect();
             let radius: Vec<f64> = (0..n).map(|_| 0.02 + 0.02 * rnd()).collect();
             let mut list = NeighborList::default();
-            list.build(&domain, &position, &radius, 0.01, &[], &[]);
+            list.build(&domain, &position, &radius, 0.01, &[], &[], false);
             for i in 0..n {
                 let mut expected = vec![];
                 for j in i + 1..n {

@@ -160,6 +160,7 @@ impl Simulation {
                 sim.config.skin_m,
                 &sim.config.walls,
                 &sim.wall_angle_rad,
+                sim.config.pseudo_2d,
             )
         });
         let layout = sim.config.contact_law.history_layout();
@@ -460,6 +461,7 @@ impl Simulation {
                 c.skin_m,
                 &c.walls,
                 &s.wall_angle_rad,
+                c.pseudo_2d,
             );
             s.history.remap(&old_list, &s.list, c.contact_law.history_layout())
         });

@@ -94,6 +94,12 @@ pub struct WallProximity {
 }
 
 impl Wall {
+    /// A static plane whose normal is along z: in pseudo-2-D runs (no motion along z) a particle's gap to it never
+    /// changes.
+    pub fn is_plane_normal_to_z(&self) -> bool {
+        matches!(self.shape, WallShape::Plane { normal, .. } if normal.x == 0.0 && normal.y == 0.0)
+    }
+
     /// Angular velocity of the wall's rotation (0 for static walls).
     pub fn angular_velocity_rad_per_s(&self) -> f64 {
         match &self.shape {
