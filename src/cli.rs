@@ -98,6 +98,26 @@ pub enum Command {
         #[arg(long)]
         out: Option<PathBuf>,
     },
+    /// Map square-well depths onto Hamaker constants by the head-on escape velocity (seed 001 ch. 7): for each
+    /// well depth, the escape velocity and the Hamaker constant with the same one. Defaults: seed 001 Table 6.2.
+    CohesionMap {
+        /// Square-well depths D, J (seed 001 Table 7.1: 1e-11 5e-11 1e-10).
+        #[arg(long, num_args = 1.., default_values_t = [1e-11, 5e-11, 1e-10])]
+        well_depth_j: Vec<f64>,
+        #[arg(long, default_value_t = 0.5e-3)]
+        radius_m: f64,
+        #[arg(long, default_value_t = 2650.0)]
+        density_kg_per_m3: f64,
+        /// Linear spring stiffness K_n, N/m.
+        #[arg(long, default_value_t = 800.0)]
+        stiffness_n_per_m: f64,
+        /// Dashpot η_n, kg/s.
+        #[arg(long, default_value_t = 0.79e-3)]
+        damping_kg_per_s: f64,
+        /// Hamaker inner cutoff H_cut, m.
+        #[arg(long, default_value_t = 4e-10)]
+        hamaker_cutoff_m: f64,
+    },
     /// Run one job of a campaign in its directory (started by the dispatcher).
     #[command(hide = true)]
     Worker {
@@ -251,6 +271,48 @@ pub fn run(cli: Cli) -> Result<i32> {
         }
         Command::Models => {
             print!("{}", crate::models_doc::MODELS);
+            Ok(0)
+        }
+        Command::CohesionMap {
+            well_depth_j,
+            radius_m,
+            density_kg_per_m3,
+            stiffness_n_per_m,
+            damping_kg_per_s,
+            hamaker_cutoff_m,
+        } => {
+            use crate::analysis::escape_velocity::{HeadOnCollision, linear_spring_restitution};
+            use crate::engine::models::cohesion::{Hamaker, SquareWell};
+            let mass = density_kg_per_m3 * 4.0 / 3.0 * std::f64::consts::PI * radius_m.powi(3);
+            let restitution = linear_spring_restitution(stiffness_n_per_m, damping_kg_per_s, 0.5 * mass);
+            let bad = |what: &str| Err(crate::error::Error::External(format!("cohesion-map: {what}")));
+            if !(restitution > 0.0 && restitution < 1.0) {
+                return bad(&format!("the contact's restitution is {restitution}: expected in (0, 1)"));
+            }
+            if well_depth_j.iter().any(|d| !(d.is_finite() && *d > 0.0)) {
+                return bad("well depths must be positive");
+            }
+            let collision = HeadOnCollision {
+                stiffness_n_per_m,
+                damping_kg_per_s,
+                particle_mass_kg: mass,
+                radius_m,
+                hamaker: Hamaker {
+                    constant_j: 0.0,
+                    cutoff_m: hamaker_cutoff_m,
+                },
+            };
+            println!("particle mass {mass:.6e} kg, contact restitution {restitution:.5}, H_cut {hamaker_cutoff_m:e} m");
+            println!("well_depth_j,escape_velocity_m_per_s,hamaker_constant_j");
+            for depth_j in well_depth_j {
+                let well = SquareWell {
+                    depth_j,
+                    outer_to_inner_radius_ratio: 1.01,
+                };
+                let v = well.escape_velocity_m_per_s(mass, restitution);
+                let a = collision.hamaker_constant_for_escape_velocity_j(v, 1e-5);
+                println!("{depth_j:e},{v:.6e},{a:.6e}");
+            }
             Ok(0)
         }
         Command::Run {

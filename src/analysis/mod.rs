@@ -6,10 +6,13 @@
 //!   of a series' maximum (seed 000 Table 1).
 //! - `granular`: granular temperature (seed 000 eq 3.1) and coordination numbers (seed 002).
 //! - `knn`: the exact k-nearest-neighbour search behind the local concentrations of `mixing`.
+//! - `escape_velocity`: the head-on escape velocity of a Hamaker pair and the Hamaker constant matching a square
+//!   well (seed 001 ch. 7).
 //!
 //! Everything here is a pure function of values passed in: nothing reads checkpoints, the store or the engine's
 //! state directly, and nothing here is called while a simulation steps.
 
+pub mod escape_velocity;
 pub mod fit;
 pub mod fluidization;
 pub mod granular;
