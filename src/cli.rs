@@ -287,7 +287,9 @@ pub fn run(cli: Cli) -> Result<i32> {
             let restitution = linear_spring_restitution(stiffness_n_per_m, damping_kg_per_s, 0.5 * mass);
             let bad = |what: &str| Err(crate::error::Error::External(format!("cohesion-map: {what}")));
             if !(restitution > 0.0 && restitution < 1.0) {
-                return bad(&format!("the contact's restitution is {restitution}: expected in (0, 1)"));
+                return bad(&format!(
+                    "the contact's restitution is {restitution}: expected in (0, 1)"
+                ));
             }
             if well_depth_j.iter().any(|d| !(d.is_finite() && *d > 0.0)) {
                 return bad("well depths must be positive");

@@ -21,7 +21,11 @@ fn cohesion_map_reproduces_seed_001_table_7_1() {
         .map(|l| l.split(',').map(|v| v.parse().unwrap()).collect())
         .collect();
     // D (J), v_esc (cm/s), A (J) of seed 001 Table 7.1.
-    let table = [(1e-11, 0.179, 3.34e-19), (5e-11, 0.400, 7.49e-19), (1e-10, 0.566, 1.06e-18)];
+    let table = [
+        (1e-11, 0.179, 3.34e-19),
+        (5e-11, 0.400, 7.49e-19),
+        (1e-10, 0.566, 1.06e-18),
+    ];
     assert_eq!(rows.len(), 3, "{text}");
     for (row, (d, v_cm, a)) in rows.iter().zip(table) {
         assert_eq!(row[0], d);

@@ -82,8 +82,8 @@ impl HeadOnCollision {
                     return false;
                 }
                 if h >= self.hamaker.cutoff_m {
-                    let energy = 0.5 * self.reduced_mass_kg() * w * w
-                        + self.hamaker.pair_potential_j(0.5 * self.radius_m, h);
+                    let energy =
+                        0.5 * self.reduced_mass_kg() * w * w + self.hamaker.pair_potential_j(0.5 * self.radius_m, h);
                     return energy > 0.0;
                 }
             }
@@ -175,8 +175,14 @@ mod tests {
             };
             let v_esc = well.escape_velocity_m_per_s(mass, e);
             let a = table_6_2(0.0).hamaker_constant_for_escape_velocity_j(v_esc, 1e-4) / ERG;
-            eprintln!("D = {d_erg} erg: v_esc = {:.4} cm/s, A = {a:.4e} erg (seed 001: {a_erg})", v_esc * 100.0);
-            assert!((a / a_erg - 1.0).abs() < 0.05, "D = {d_erg} erg: A = {a} erg vs {a_erg}");
+            eprintln!(
+                "D = {d_erg} erg: v_esc = {:.4} cm/s, A = {a:.4e} erg (seed 001: {a_erg})",
+                v_esc * 100.0
+            );
+            assert!(
+                (a / a_erg - 1.0).abs() < 0.05,
+                "D = {d_erg} erg: A = {a} erg vs {a_erg}"
+            );
             // And back: that A gives the well's escape velocity.
             let back = table_6_2(a).escape_velocity_m_per_s(1e-5);
             assert!((back / v_esc - 1.0).abs() < 1e-3, "{back} vs {v_esc}");

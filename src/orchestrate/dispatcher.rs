@@ -533,6 +533,16 @@ fn hostname() -> String {
         .unwrap_or_else(|| "localhost".to_string())
 }
 
+/// The running binary, for its workers. On Linux `/proc/self/exe`, which executes this very binary even after its
+/// file was replaced (a rebuild or an upgrade during a campaign: `current_exe()` then names a deleted file and no
+/// further worker could start), so every worker of a dispatcher runs the dispatcher's own version.
+fn own_executable() -> Result<PathBuf, Error> {
+    if cfg!(target_os = "linux") {
+        return Ok(PathBuf::from("/proc/self/exe"));
+    }
+    std::env::current_exe().map_err(|e| Error::External(format!("cannot find the granflow binary: {e}")))
+}
+
 /// Starts `granflow worker <dir>` and a task that forwards its messages and its exit.
 fn spawn(
     job: &JobSpec,
@@ -541,7 +551,7 @@ fn spawn(
     tx: mpsc::UnboundedSender<FromWorker>,
 ) -> Result<(Option<u32>, Option<ChildStdin>), Error> {
     let dir = job_dir(&settings.out, &job.job_id);
-    let exe = std::env::current_exe().map_err(|e| Error::External(format!("cannot find the granflow binary: {e}")))?;
+    let exe = own_executable()?;
     let log_path = dir.join("worker.log");
     let log = std::fs::OpenOptions::new()
         .create(true)

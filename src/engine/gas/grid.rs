@@ -14,8 +14,8 @@ pub enum Boundary {
     /// Gas enters (or leaves) with this velocity; tangential components act as a moving wall.
     Inlet { velocity_m_per_s: [f64; 3] },
     /// Gas leaves with zero normal gradient of velocity; the pressure there is the reference (0). The outflow is
-    /// scaled so that the domain conserves mass (inflow minus the change of gas volume inside). Faces where the
-    /// gas inside flows back towards the outlet are closed (no inflow through an outlet).
+    /// scaled so that the domain conserves mass (inflow minus the change of gas volume inside); faces where gas
+    /// flows back in keep their zero-gradient value and are not scaled.
     Outlet,
 }
 

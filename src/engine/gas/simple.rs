@@ -231,15 +231,11 @@ impl GasSolver {
                     self.state.velocity_m_per_s[a][f] = match b {
                         Boundary::Inlet { velocity_m_per_s } => velocity_m_per_s[a],
                         Boundary::Outlet if grid.n[a] > 1 => {
-                            // Zero gradient from the next face inwards, but never inflow: a face where the copy would
-                            // point into the domain is closed (OpenFOAM's inletOutlet). Copying a return flow and then
-                            // scaling the outlet up to the needed outflow amplifies it from one outer iteration to
-                            // the next until the step diverges (seen in a jet bed's freeboard).
+                            // Zero gradient: the next face inwards (a return flow included; `balance_outlets` scales
+                            // only the outflowing faces).
                             let mut inner = idx;
                             inner[a] = if along == 0 { 1 } else { grid.n[a] - 1 };
-                            let u = self.state.velocity_m_per_s[a][grid.face(a, inner)];
-                            let outward = if along == 0 { -u } else { u };
-                            if outward > 0.0 { u } else { 0.0 }
+                            self.state.velocity_m_per_s[a][grid.face(a, inner)]
                         }
                         _ => 0.0,
                     };
@@ -268,6 +264,7 @@ impl GasSolver {
         let rho = self.config.density_kg_per_m3;
         let (mut inflow, mut outflow) = (0.0, 0.0);
         let mut outlet_faces = Vec::new();
+        let mut returning = Vec::new();
         for a in 0..grid.axes() {
             if grid.periodic(a) {
                 continue;
@@ -285,12 +282,28 @@ impl GasSolver {
                     continue;
                 }
                 if matches!(grid.boundary[side(a, along != 0)], Boundary::Outlet) {
+                    // A face where gas flows back in keeps its zero-gradient value and counts as inflow: scaling it
+                    // with the outflow amplified the return flow from one outer iteration to the next until a jet
+                    // bed's gas step diverged (D7 at t = 0.63 s).
+                    if inward * flux > 0.0 {
+                        returning.push((a, f, inward, flux));
+                        continue;
+                    }
                     outflow -= inward * flux;
                     outlet_faces.push((a, f, inward));
                 } else {
                     inflow += inward * flux;
                 }
             }
+        }
+        if outlet_faces.is_empty() {
+            // Gas flows back in through every outlet face: scale them all (nothing else can balance the domain).
+            for &(a, f, inward, flux) in &returning {
+                outflow -= inward * flux;
+                outlet_faces.push((a, f, inward));
+            }
+        } else {
+            inflow += returning.iter().map(|&(_, _, inward, flux)| inward * flux).sum::<f64>();
         }
         if outlet_faces.is_empty() {
             return;

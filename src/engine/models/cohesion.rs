@@ -106,7 +106,13 @@ mod tests {
     fn hamaker_maximum_force_over_weight_matches_seed_001() {
         let radius: f64 = 0.5e-3;
         let weight = 2650.0 * 4.0 / 3.0 * PI * radius.powi(3) * 9.81;
-        for (a_erg, ratio) in [(3.34e-12, 6.4), (7.49e-12, 14.3), (1.0e-11, 19.1), (1.06e-11, 20.3), (1e-10, 191.0)] {
+        for (a_erg, ratio) in [
+            (3.34e-12, 6.4),
+            (7.49e-12, 14.3),
+            (1.0e-11, 19.1),
+            (1.06e-11, 20.3),
+            (1e-10, 191.0),
+        ] {
             let h = Hamaker {
                 constant_j: a_erg * ERG,
                 cutoff_m: 4e-10,
@@ -130,7 +136,10 @@ mod tests {
                 outer_to_inner_radius_ratio: 1.01,
             };
             let v = well.escape_velocity_m_per_s(mass, restitution) * 100.0;
-            assert!((v - v_cm_per_s).abs() < 0.0006, "D = {d_erg} erg: {v} cm/s vs {v_cm_per_s}");
+            assert!(
+                (v - v_cm_per_s).abs() < 0.0006,
+                "D = {d_erg} erg: {v} cm/s vs {v_cm_per_s}"
+            );
             let back = SquareWell::depth_for_escape_velocity_j(v / 100.0, mass, restitution);
             assert!((back / well.depth_j - 1.0).abs() < 1e-12);
         }

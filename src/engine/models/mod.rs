@@ -9,6 +9,7 @@ pub mod normal;
 pub mod pair_table;
 pub mod rolling;
 pub mod tangential;
+pub mod young_laplace;
 
 pub use contact_law::{ContactKinematics, ContactLaw, ContactOutput};
 pub use history::ContactHistory;
