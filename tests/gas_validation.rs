@@ -457,7 +457,10 @@ fn an_outlet_keeps_a_return_flow_unscaled_and_balances_mass() {
     let returning = (0..10).filter(|&i| below(i) < 0.0).count();
     assert!(returning > 0, "the test needs a return flow below the outlet");
     let returning_at_outlet = (0..10).filter(|&i| top(i) < 0.0).count();
-    assert!(returning_at_outlet > 0, "the test needs gas flowing back in at the outlet");
+    assert!(
+        returning_at_outlet > 0,
+        "the test needs gas flowing back in at the outlet"
+    );
     for i in 0..10 {
         if top(i) < 0.0 {
             assert_eq!(top(i), below(i), "a returning outlet face keeps the value below it");
