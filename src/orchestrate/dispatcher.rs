@@ -558,7 +558,11 @@ fn spawn(
         .append(true)
         .open(&log_path)
         .map_err(|e| Error::io("open", &log_path, e))?;
-    let mut child: Child = Command::new(exe)
+    let mut command = Command::new(exe);
+    // Listed as `granflow worker …` by ps, not as /proc/self/exe.
+    #[cfg(unix)]
+    command.arg0("granflow");
+    let mut child: Child = command
         .arg("worker")
         .arg(&dir)
         .arg("--threads")
