@@ -70,6 +70,25 @@ impl StencilSystem {
     }
 }
 
+impl SolveReport {
+    /// The report of a system with b = 0 (solved by x = 0).
+    const ZERO_RIGHT_HAND_SIDE: SolveReport = SolveReport {
+        iterations: 0,
+        relative_residual: 0.0,
+        converged: true,
+    };
+}
+
+/// ‖b‖, or `None` after setting x = 0 when b = 0 (the solution; no iteration needed).
+fn right_hand_side_norm(sys: &StencilSystem, x: &mut [f64]) -> Option<f64> {
+    let b_norm = norm(&sys.b);
+    if b_norm == 0.0 {
+        x.iter_mut().for_each(|v| *v = 0.0);
+        return None;
+    }
+    Some(b_norm)
+}
+
 fn dot(a: &[f64], b: &[f64]) -> f64 {
     a.iter().zip(b).map(|(x, y)| x * y).sum()
 }
@@ -201,15 +220,9 @@ pub fn conjugate_gradient(
     remove_mean: bool,
 ) -> SolveReport {
     let n = sys.len();
-    let b_norm = norm(&sys.b);
-    if b_norm == 0.0 {
-        x.iter_mut().for_each(|v| *v = 0.0);
-        return SolveReport {
-            iterations: 0,
-            relative_residual: 0.0,
-            converged: true,
-        };
-    }
+    let Some(b_norm) = right_hand_side_norm(sys, x) else {
+        return SolveReport::ZERO_RIGHT_HAND_SIDE;
+    };
     let rows = CompactRows::new(sys);
     let precond = DiagonalIncompleteCholesky::new(&rows);
     let mut r = vec![0.0; n];
@@ -301,15 +314,9 @@ pub fn bandwidth(sys: &StencilSystem) -> usize {
 /// system; `remove_mean` then subtracts the mean of `x`. Reports 1 iteration and the true relative residual.
 pub fn direct_symmetric(sys: &StencilSystem, x: &mut [f64], remove_mean: bool) -> SolveReport {
     let n = sys.len();
-    let b_norm = norm(&sys.b);
-    if b_norm == 0.0 {
-        x.iter_mut().for_each(|v| *v = 0.0);
-        return SolveReport {
-            iterations: 0,
-            relative_residual: 0.0,
-            converged: true,
-        };
-    }
+    let Some(b_norm) = right_hand_side_norm(sys, x) else {
+        return SolveReport::ZERO_RIGHT_HAND_SIDE;
+    };
     let bw = bandwidth(sys);
     let width = bw + 1;
     // Row p of the lower band: l[p * width + (q + bw − p)] for q in p − bw ..= p (the diagonal last), first A,
@@ -385,15 +392,9 @@ pub fn direct_symmetric(sys: &StencilSystem, x: &mut [f64], remove_mean: bool) -
 /// result.
 pub fn bicgstab(sys: &StencilSystem, x: &mut [f64], tolerance: f64, max_iterations: usize) -> SolveReport {
     let n = sys.len();
-    let b_norm = norm(&sys.b);
-    if b_norm == 0.0 {
-        x.iter_mut().for_each(|v| *v = 0.0);
-        return SolveReport {
-            iterations: 0,
-            relative_residual: 0.0,
-            converged: true,
-        };
-    }
+    let Some(b_norm) = right_hand_side_norm(sys, x) else {
+        return SolveReport::ZERO_RIGHT_HAND_SIDE;
+    };
     let rows = CompactRows::new(sys);
     let inv_diag: Vec<f64> = sys.ap.iter().map(|a| if *a != 0.0 { 1.0 / a } else { 1.0 }).collect();
     let mut r = vec![0.0; n];
