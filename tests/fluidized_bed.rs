@@ -65,6 +65,12 @@ fn a_semi_implicit_bed_restarts_bit_identically_with_its_gas() {
     restart_is_exact("  drag_coupling: semi_implicit\n  drag_velocities: cell_averaged");
 }
 
+#[test]
+fn a_bed_under_an_inflow_ramp_restarts_bit_identically() {
+    // The stop at step 1503 (t = 15 ms) falls inside the ramp (5-25 ms).
+    restart_is_exact("  inflow_ramp: { start_s: 0.005, duration_s: 0.02 }");
+}
+
 fn restart_is_exact(extra: &str) {
     let tmp = tempfile::tempdir().expect("temp dir");
     let dir = tmp.path();
@@ -137,6 +143,16 @@ fn bad_gas_input_is_rejected_with_its_key_before_anything_is_written() {
         ),
         ("viscosity_pa_s: 1.8e-5", "viscosity_pa_s: 0.0", "gas.viscosity_pa_s"),
         ("drag: di_felice", "drag: di_felise", "di_felice"),
+        (
+            "dem_steps_per_gas_step: 7",
+            "dem_steps_per_gas_step: 7\n  inflow_ramp: { start_s: -0.1, duration_s: 0.1 }",
+            "gas.inflow_ramp.start_s",
+        ),
+        (
+            "dem_steps_per_gas_step: 7",
+            "dem_steps_per_gas_step: 7\n  inflow_ramp: { start_s: 0.0, duration_s: .nan }",
+            "gas.inflow_ramp.duration_s",
+        ),
     ];
     let tmp = tempfile::tempdir().expect("temp dir");
     let dir = tmp.path();
@@ -200,6 +216,37 @@ fn a_jet_carries_its_own_inflow() {
     // Bottom faces of v (normal to y): the first row of 4.
     let bottom = &gas.velocity_m_per_s[1][..4];
     assert_eq!(bottom, &[2.5, 10.0, 10.0, 2.5], "inlet faces: {bottom:?}");
+}
+
+#[test]
+fn an_inflow_ramp_scales_every_inlet_until_it_ends() {
+    let tmp = tempfile::tempdir().expect("temp dir");
+    let dir = tmp.path();
+    // The run ends 5 ms into a 10 ms ramp: the side and the jet are both at the ramp's fraction of their value.
+    let text = bed(
+        0.005,
+        "  inflow_ramp: { start_s: 0.0, duration_s: 0.01 }\n  jets: [ { side: y_low, lo_m: [0.01, 0.0, 0.0], hi_m: [0.02, 0.0, 0.0027], superficial_velocity_m_per_s: 10.0 } ]",
+    );
+    std::fs::write(dir.join("ramp.yaml"), text).unwrap();
+    run_ok(&["simulate", "ramp.yaml", "--out", "ramp", "--quiet"], dir);
+    let gas = final_state(&dir.join("ramp")).gas.expect("gas");
+    let fraction = gas.time_s / 0.01;
+    assert!(fraction > 0.45 && fraction < 0.5, "gas time {}", gas.time_s);
+    let bottom = &gas.velocity_m_per_s[1][..4];
+    let expected = [2.5, 10.0, 10.0, 2.5].map(|u| u * fraction);
+    for (got, want) in bottom.iter().zip(expected) {
+        assert!(
+            (got - want).abs() <= 1e-12 * want,
+            "inlet faces {bottom:?}, expected {expected:?}"
+        );
+    }
+    // The outlet carries what came in (mass balance of the ramped inflow; the gas is nearly incompressible here).
+    let top = &gas.velocity_m_per_s[1][gas.velocity_m_per_s[1].len() - 4..];
+    let (inflow, outflow): (f64, f64) = (bottom.iter().sum(), top.iter().sum());
+    assert!(
+        (outflow - inflow).abs() < 0.05 * inflow,
+        "outflow {outflow} vs inflow {inflow}"
+    );
 }
 
 #[test]

@@ -55,6 +55,7 @@ time: {{ dt_s: 1.0e-4, end_time_s: 2.0 }}
         max_linear_iterations: 1000,
         pressure_solver: Default::default(),
         inlet_faces: Vec::new(),
+        inflow_ramp: None,
         blocked: Vec::new(),
     };
     let mass = dem.particles.mass_kg[0];

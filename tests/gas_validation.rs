@@ -19,6 +19,7 @@ fn config(grid: Grid, density: f64, viscosity: f64, convection: Convection) -> G
         max_linear_iterations: 2000,
         pressure_solver: Default::default(),
         inlet_faces: Vec::new(),
+        inflow_ramp: None,
         blocked: Vec::new(),
     }
 }

@@ -14,7 +14,7 @@ use crate::engine::gas::coupling::PorosityMethod;
 use crate::engine::gas::fluid_forces::{DragCoupling, DragVelocities};
 use crate::engine::gas::grid::side;
 use crate::engine::gas::linsolve::PressureSolver;
-use crate::engine::gas::simple::InletFace;
+use crate::engine::gas::simple::{InflowRamp, InletFace};
 use crate::engine::gas::{Boundary, Convection, GasConfig, Grid};
 use crate::engine::models::drag::DragLaw;
 
@@ -58,6 +58,10 @@ pub struct GasSpec {
     pub convection: Convection,
     #[serde(default)]
     pub solver: GasSolverSpec,
+    /// Inflow off until `start_s`, then rising linearly to full over `duration_s`, on every inlet side and jet: the
+    /// particles settle before the gas starts, so that all runs of a velocity sweep start from one packing.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub inflow_ramp: Option<InflowRamp>,
     /// Height above the inlet where the pressure-drop probe sits (seed 002 Fig. 3: 20 cm). The series always has
     /// the whole-column drop too.
     #[serde(default)]
@@ -374,6 +378,20 @@ pub fn build_gas(
         origin_m: domain_lo_m,
         boundary,
     };
+    if let Some(ramp) = spec.inflow_ramp {
+        if !ramp.start_s.is_finite() || ramp.start_s < 0.0 {
+            return Err(fail(
+                "gas.inflow_ramp.start_s".into(),
+                format!("expected a time >= 0 s, got {}", ramp.start_s),
+            ));
+        }
+        if !ramp.duration_s.is_finite() || ramp.duration_s < 0.0 {
+            return Err(fail(
+                "gas.inflow_ramp.duration_s".into(),
+                format!("expected a duration >= 0 s, got {}", ramp.duration_s),
+            ));
+        }
+    }
     let mut inlet_faces = Vec::new();
     for (k, jet) in spec.jets.iter().enumerate() {
         let key = |f: &str| format!("gas.jets[{k}].{f}");
@@ -480,6 +498,7 @@ pub fn build_gas(
         max_linear_iterations: s.max_linear_iterations,
         pressure_solver: s.pressure_solver,
         inlet_faces,
+        inflow_ramp: spec.inflow_ramp,
         blocked,
     };
     config.grid.check().map_err(|m| fail("gas.cells".into(), m))?;

@@ -52,6 +52,9 @@ pub struct GasConfig {
     /// Boundary faces through which gas enters at their own velocity (jets through chosen distributor cells),
     /// overriding what their side says.
     pub inlet_faces: Vec<InletFace>,
+    /// Inflow switched on gradually: every inlet side and inlet face is multiplied by its factor at the step's end
+    /// time. `None`: full inflow from the start.
+    pub inflow_ramp: Option<InflowRamp>,
     /// Cells outside the gas domain (solid: a kiln wall's outside), one flag per cell, or empty for none. Their
     /// faces are no-slip walls at rest; the design leaves room for moving them (a wall velocity per face).
     pub blocked: Vec<bool>,
@@ -66,6 +69,30 @@ pub struct InletFace {
     pub face: usize,
     /// Velocity along `axis`, m/s (positive along the axis: into the domain on the low side).
     pub velocity_m_per_s: f64,
+}
+
+/// Inflow that is off until `start_s` and then rises linearly to its full value over `duration_s` (a bed that
+/// settles under gravity before the blower starts, as in an experiment; all runs of a velocity sweep then start
+/// from the same packing).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize, schemars::JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct InflowRamp {
+    pub start_s: f64,
+    #[serde(default)]
+    pub duration_s: f64,
+}
+
+impl InflowRamp {
+    /// The fraction of the full inflow at `time_s`: 0 up to `start_s`, 1 from `start_s + duration_s` on.
+    pub fn factor(&self, time_s: f64) -> f64 {
+        if time_s <= self.start_s {
+            0.0
+        } else if time_s >= self.start_s + self.duration_s {
+            1.0
+        } else {
+            (time_s - self.start_s) / self.duration_s
+        }
+    }
 }
 
 /// The gas state: everything a checkpoint needs.
@@ -124,10 +151,11 @@ fn all_indices(dims: [usize; 3]) -> impl Iterator<Item = [usize; 3]> {
     (0..dims[2]).flat_map(move |k| (0..dims[1]).flat_map(move |j| (0..dims[0]).map(move |i| [i, j, k])))
 }
 
-/// Boundary velocity (all three components) on a side.
-fn side_velocity(b: Boundary) -> [f64; 3] {
+/// Boundary velocity (all three components) on a side; an inlet's is multiplied by `inflow_factor`.
+fn side_velocity(b: Boundary, inflow_factor: f64) -> [f64; 3] {
     match b {
-        Boundary::Wall { velocity_m_per_s } | Boundary::Inlet { velocity_m_per_s } => velocity_m_per_s,
+        Boundary::Wall { velocity_m_per_s } => velocity_m_per_s,
+        Boundary::Inlet { velocity_m_per_s } => velocity_m_per_s.map(|v| v * inflow_factor),
         Boundary::Periodic | Boundary::Outlet => [0.0; 3],
     }
 }
@@ -145,6 +173,8 @@ pub struct GasSolver {
     /// Per component and face: gas enters here from a plenum (an inlet side or an inlet face), so the face's
     /// porosity is 1 and its velocity is the superficial velocity.
     plenum: [Vec<bool>; 3],
+    /// The inflow ramp's factor at the end of the current step (1 without a ramp).
+    inflow_factor: f64,
 }
 
 impl GasSolver {
@@ -208,9 +238,16 @@ impl GasSolver {
             face_of,
             d,
             plenum,
+            inflow_factor: 1.0,
         };
+        solver.inflow_factor = solver.inflow_factor_at(solver.state.time_s);
         solver.apply_boundary_velocities();
         Ok(solver)
+    }
+
+    /// The inflow ramp's factor at `time_s` (1 without a ramp).
+    pub fn inflow_factor_at(&self, time_s: f64) -> f64 {
+        self.config.inflow_ramp.map_or(1.0, |r| r.factor(time_s))
     }
 
     /// Sets boundary-face normal velocities (walls 0, inlets their velocity) and periodic aliases.
@@ -229,7 +266,7 @@ impl GasSolver {
                 } else if along == 0 || along == grid.n[a] {
                     let b = grid.boundary[side(a, along == grid.n[a])];
                     self.state.velocity_m_per_s[a][f] = match b {
-                        Boundary::Inlet { velocity_m_per_s } => velocity_m_per_s[a],
+                        Boundary::Inlet { velocity_m_per_s } => velocity_m_per_s[a] * self.inflow_factor,
                         Boundary::Outlet if grid.n[a] > 1 => {
                             // Zero gradient: the next face inwards (a return flow included; `balance_outlets` scales
                             // only the outflowing faces).
@@ -243,7 +280,7 @@ impl GasSolver {
             }
         }
         for f in &self.config.inlet_faces {
-            self.state.velocity_m_per_s[f.axis][f.face] = f.velocity_m_per_s;
+            self.state.velocity_m_per_s[f.axis][f.face] = f.velocity_m_per_s * self.inflow_factor;
         }
         if !self.config.blocked.is_empty() {
             let grid = &self.config.grid;
@@ -469,7 +506,7 @@ impl GasSolver {
                             let diff = mu * eps_f * area_d / (0.5 * grid.h_m[dax]);
                             add(
                                 &mut sys,
-                                Err(side_velocity(boundary)[c]),
+                                Err(side_velocity(boundary, self.inflow_factor)[c]),
                                 coefficient(-sign * flux, diff),
                                 &mut ap,
                                 &mut b,
@@ -565,6 +602,9 @@ impl GasSolver {
     ) -> StepReport {
         let axes = self.config.grid.axes();
         let old: [Vec<f64>; 3] = self.state.velocity_m_per_s.clone();
+        // Boundary values are those at the end of the step (the scheme is implicit in time).
+        self.inflow_factor = self.inflow_factor_at(self.state.time_s + dt_s);
+        self.apply_boundary_velocities();
         let mut report = StepReport {
             outer_iterations: 0,
             mass_imbalance: f64::INFINITY,
@@ -746,4 +786,28 @@ fn face_touches_blocked(grid: &Grid, blocked: &[bool], axis: usize, idx: [usize;
 fn face_index(grid: &Grid, axis: usize, f: usize) -> [usize; 3] {
     let d = grid.face_dims(axis);
     [f % d[0], (f / d[0]) % d[1], f / (d[0] * d[1])]
+}
+
+#[cfg(test)]
+mod tests {
+    use super::InflowRamp;
+
+    #[test]
+    fn an_inflow_ramp_is_off_then_linear_then_full() {
+        let ramp = InflowRamp {
+            start_s: 0.5,
+            duration_s: 0.25,
+        };
+        assert_eq!(ramp.factor(0.0), 0.0);
+        assert_eq!(ramp.factor(0.5), 0.0);
+        assert!((ramp.factor(0.6) - 0.4).abs() < 1e-12);
+        assert_eq!(ramp.factor(0.75), 1.0);
+        assert_eq!(ramp.factor(10.0), 1.0);
+        let switch = InflowRamp {
+            start_s: 0.5,
+            duration_s: 0.0,
+        };
+        assert_eq!(switch.factor(0.5), 0.0);
+        assert_eq!(switch.factor(0.5 + 1e-12), 1.0);
+    }
 }
