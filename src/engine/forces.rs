@@ -640,8 +640,10 @@ pub struct RangePlan {
 
 impl RangePlan {
     /// Ranges per thread. More ranges than threads let a thread that the machine delays hand its unstarted ranges
-    /// to the other threads (see `Team::map_parts`), at the price of more pairs crossing a range boundary.
-    pub const PER_THREAD: usize = 4;
+    /// to the other threads (see `Team::map_parts`), at the price of more pairs crossing a range boundary. Measured
+    /// on the benchmark column with 2 threads (`granflow bench dem --threads 2 --speedup`, 2026-12-01): 2 per thread
+    /// gave speed-ups of 1.79-1.82, 4 gave 1.78-1.80 (and 1.69-1.73 at 8,000 steps), 8 gave 1.68, 16 gave 1.55-1.58.
+    pub const PER_THREAD: usize = 2;
 
     /// How many ranges `threads` threads work on (one range, the serial pass, on one thread).
     pub fn ranges_for(threads: usize) -> usize {
