@@ -163,10 +163,9 @@ impl FaceLattice {
     }
 
     /// The trilinear stencil at `x`: clamped at non-periodic edges (a point beyond the last face takes that face),
-    /// wrapped on periodic axes. With `inward`, faces on a non-periodic boundary of the component's own axis are
-    /// replaced by the next face inwards (how the drag reaction keeps its boundary share inside the gas).
+    /// wrapped on periodic axes.
     #[inline]
-    pub fn stencil(&self, x: &Vec3, inward: bool) -> Stencil {
+    pub fn stencil(&self, x: &Vec3) -> Stencil {
         let mut lo = [0usize; 3];
         let mut hi = [0usize; 3];
         let mut w = [0.0f64; 3];
@@ -188,11 +187,6 @@ impl FaceLattice {
                 } else {
                     (base as usize, base as usize + 1, frac)
                 };
-                if inward && a == self.axis && max >= 2 {
-                    let m = max as usize - 1;
-                    lo[a] = lo[a].clamp(1, m);
-                    hi[a] = hi[a].clamp(1, m);
-                }
             }
         }
         let mut out = Stencil {
@@ -220,7 +214,7 @@ impl FaceLattice {
     /// The component's value at `x` from its face values.
     #[inline]
     pub fn interpolate(&self, values: &[f64], x: &Vec3) -> f64 {
-        self.stencil(x, false).apply(values)
+        self.stencil(x).apply(values)
     }
 }
 
