@@ -89,12 +89,7 @@ pub fn viscous_tangential_coefficient_n_s_per_m(
 
 /// The liquid each particle gives to a new bridge (seed 000 eqs 6.1–6.4): particle i gives the liquid on its cap
 /// facing j, V_i = (L_i/2)(1 − √(1 − R_j²/(R_i + R_j)²)), and likewise j. Returns (from i, from j), m³.
-pub fn bridge_volume_on_contact_m3(
-    liquid_i_m3: f64,
-    radius_i_m: f64,
-    liquid_j_m3: f64,
-    radius_j_m: f64,
-) -> (f64, f64) {
+pub fn bridge_volume_on_contact_m3(liquid_i_m3: f64, radius_i_m: f64, liquid_j_m3: f64, radius_j_m: f64) -> (f64, f64) {
     let cap = |liquid: f64, other_radius: f64| {
         let s = other_radius / (radius_i_m + radius_j_m);
         0.5 * liquid * (1.0 - (1.0 - s * s).sqrt())
@@ -146,7 +141,10 @@ mod tests {
                 let volume = v_hat * r * r * r;
                 let mikami = mikami_rupture_gap_m(r_star, volume, theta);
                 let lian = lian_rupture_gap_m(volume, theta, theta);
-                assert!((mikami / lian - 1.0).abs() < 0.06, "θ {theta_deg} V̂ {v_hat}: {mikami} vs {lian}");
+                assert!(
+                    (mikami / lian - 1.0).abs() < 0.06,
+                    "θ {theta_deg} V̂ {v_hat}: {mikami} vs {lian}"
+                );
                 let mut previous = f64::INFINITY;
                 for k in 0..=20 {
                     let f = mikami_force_n(r_star, volume, mikami * k as f64 / 20.0, theta, 0.07);
