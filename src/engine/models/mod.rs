@@ -6,6 +6,7 @@ pub mod cohesion;
 pub mod contact_law;
 pub mod drag;
 pub mod history;
+pub mod liquid_transfer;
 pub mod normal;
 pub mod pair_table;
 pub mod rolling;
