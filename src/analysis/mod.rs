@@ -6,12 +6,15 @@
 //!   of a series' maximum (seed 000 Table 1).
 //! - `granular`: granular temperature (seed 000 eq 3.1) and coordination numbers (seed 002).
 //! - `knn`: the exact k-nearest-neighbour search behind the local concentrations of `mixing`.
+//! - `dimensionless`: the granular Bond and capillary numbers of wet particles, single and binary, and the wet phase
+//!   rule (seed 000 §4).
 //! - `escape_velocity`: the head-on escape velocity of a Hamaker pair and the Hamaker constant matching a square
 //!   well (seed 001 ch. 7).
 //!
 //! Everything here is a pure function of values passed in: nothing reads checkpoints, the store or the engine's
 //! state directly, and nothing here is called while a simulation steps.
 
+pub mod dimensionless;
 pub mod escape_velocity;
 pub mod fit;
 pub mod fluidization;

@@ -40,6 +40,16 @@ fn wen_yu_cd(re: f64, high_re_cd: f64) -> f64 {
     }
 }
 
+/// Di Felice's single-sphere drag coefficient C_d = (0.63 + 4.8/√Re)² (seed 000 eq 2.72), Re = 2R ρ_g ε |u − v|/μ.
+pub fn di_felice_drag_coefficient(re: f64) -> f64 {
+    (0.63 + 4.8 / re.sqrt()).powi(2)
+}
+
+/// Di Felice's voidage exponent χ = 3.7 − 0.65 exp(−(1.5 − log₁₀ Re)²/2) (seed 000 eq 2.73).
+pub fn di_felice_exponent(re: f64) -> f64 {
+    3.7 - 0.65 * (-(1.5 - re.log10()).powi(2) / 2.0).exp()
+}
+
 /// Terminal-velocity ratio of Garside & Al-Dibouni (seed 001 eqs 6.6–6.8).
 pub fn garside_al_dibouni_vr(porosity: f64, re: f64) -> f64 {
     let a = porosity.powf(4.14);
@@ -68,8 +78,7 @@ impl DragLaw {
                     return 0.5 * cd_w * rho * PI * d * d / 4.0 * eps.powf(2.0 - 3.7);
                 }
                 let re = rho * d * eps * w / mu;
-                let cd = (0.63 + 4.8 / re.sqrt()).powi(2);
-                let chi = 3.7 - 0.65 * (-(1.5 - re.log10()).powi(2) / 2.0).exp();
+                let (cd, chi) = (di_felice_drag_coefficient(re), di_felice_exponent(re));
                 0.5 * cd * rho * PI * d * d / 4.0 * w * eps.powf(2.0 - chi)
             }
             DragLaw::ErgunWenYu | DragLaw::ErgunWenYuSeed002 => {
