@@ -129,6 +129,16 @@ mod tests {
 
     const G: f64 = 9.81;
 
+    /// Air slipping past the beads at 1.8 m/s in a bed of porosity 0.5.
+    fn air_at_1_8_m_per_s() -> GasSlip {
+        GasSlip {
+            density_kg_per_m3: 1.23,
+            viscosity_pa_s: 1.8e-5,
+            slip_speed_m_per_s: 1.8,
+            porosity: 0.5,
+        }
+    }
+
     fn particle(radius_mm: f64, density: f64, theta_deg: f64) -> WetParticle {
         WetParticle {
             radius_m: radius_mm * 1e-3,
@@ -150,12 +160,7 @@ mod tests {
     #[test]
     fn capillary_number_is_the_force_over_di_felice_drag() {
         let p = particle(1.35, 2000.0, 0.0);
-        let gas = GasSlip {
-            density_kg_per_m3: 1.23,
-            viscosity_pa_s: 1.8e-5,
-            slip_speed_m_per_s: 1.8,
-            porosity: 0.5,
-        };
+        let gas = air_at_1_8_m_per_s();
         // By hand: Re = 2R ρ ε w/μ = 166.05, C_d = (0.63 + 4.8/√Re)², χ = 3.7 − 0.65 e^{−(1.5 − log Re)²/2}.
         let re: f64 = 2.0 * 1.35e-3 * 1.23 * 0.5 * 1.8 / 1.8e-5;
         let cd = (0.63 + 4.8 / re.sqrt()).powi(2);
@@ -250,12 +255,7 @@ mod tests {
     fn the_binary_capillary_number_divides_by_the_drag_of_the_kind_easier_to_lift() {
         let a = particle(1.35, 2000.0, 0.0);
         let b = particle(1.5, 1000.0, 0.0);
-        let gas = GasSlip {
-            density_kg_per_m3: 1.23,
-            viscosity_pa_s: 1.8e-5,
-            slip_speed_m_per_s: 1.8,
-            porosity: 0.5,
-        };
+        let gas = air_at_1_8_m_per_s();
         // The light kind has the larger drag-to-weight ratio.
         let ca12 = binary_granular_capillary_number(&a, &b, 0.03, &gas, G);
         let expected = pair_capillary_force_n(&a, &b, 0.03) / di_felice_drag_n(b.radius_m, &gas);
