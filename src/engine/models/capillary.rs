@@ -75,7 +75,8 @@ pub fn viscous_normal_force_n(
 
 /// Magnitude factor of the viscous tangential force (seed 000 eq 2.20 for two spheres, after Goldman, Cox &
 /// Brenner): F_t = (8/15 ln(R*/S) + 0.9588) 6πμ R* v_t, with S ≥ `min_gap_m`; returns the coefficient multiplying
-/// v_t (N s/m). The force opposes the tangential relative velocity.
+/// v_t (N s/m). The force opposes the tangential relative velocity. The factor is held at 0 where the fit's
+/// logarithm would make it negative (S > 6.0 R*, beyond any pendular bridge's rupture gap).
 pub fn viscous_tangential_coefficient_n_s_per_m(
     effective_radius_m: f64,
     viscosity_pa_s: f64,
