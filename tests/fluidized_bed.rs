@@ -7,6 +7,7 @@ use std::path::Path;
 
 use common::granflow;
 use granflow::checkpoint::CheckpointSeries;
+use granflow::engine::gas::coupled::GasSnapshot;
 use granflow::engine::state::{SimState, first_difference};
 
 /// A small pseudo-2-D bed: 100 beads of 2.7 mm, 10 layers, gas inflow 2.5 m/s from below (fluidized).
@@ -43,6 +44,14 @@ fn final_state(dir: &Path) -> SimState {
         .expect("lists")
         .expect("a checkpoint exists");
     loaded.state
+}
+
+/// Runs scenario `text` as `<name>.yaml` into `<name>/` and returns the gas of its last checkpoint.
+fn final_gas(dir: &Path, name: &str, text: &str) -> GasSnapshot {
+    let file = format!("{name}.yaml");
+    std::fs::write(dir.join(&file), text).unwrap();
+    run_ok(&["simulate", &file, "--out", name, "--quiet"], dir);
+    final_state(&dir.join(name)).gas.expect("the checkpoint holds the gas")
 }
 
 fn run_ok(args: &[&str], cwd: &Path) -> String {
@@ -209,10 +218,7 @@ fn a_jet_carries_its_own_inflow() {
         0.005,
         "  jets: [ { side: y_low, lo_m: [0.01, 0.0, 0.0], hi_m: [0.02, 0.0, 0.0027], superficial_velocity_m_per_s: 10.0 } ]",
     );
-    std::fs::write(dir.join("jet.yaml"), text).unwrap();
-    run_ok(&["simulate", "jet.yaml", "--out", "jet", "--quiet"], dir);
-    let state = final_state(&dir.join("jet"));
-    let gas = state.gas.expect("gas");
+    let gas = final_gas(dir, "jet", &text);
     // Bottom faces of v (normal to y): the first row of 4.
     let bottom = &gas.velocity_m_per_s[1][..4];
     assert_eq!(bottom, &[2.5, 10.0, 10.0, 2.5], "inlet faces: {bottom:?}");
@@ -227,9 +233,7 @@ fn an_inflow_ramp_scales_every_inlet_until_it_ends() {
         0.005,
         "  inflow_ramp: { start_s: 0.0, duration_s: 0.01 }\n  jets: [ { side: y_low, lo_m: [0.01, 0.0, 0.0], hi_m: [0.02, 0.0, 0.0027], superficial_velocity_m_per_s: 10.0 } ]",
     );
-    std::fs::write(dir.join("ramp.yaml"), text).unwrap();
-    run_ok(&["simulate", "ramp.yaml", "--out", "ramp", "--quiet"], dir);
-    let gas = final_state(&dir.join("ramp")).gas.expect("gas");
+    let gas = final_gas(dir, "ramp", &text);
     let fraction = gas.time_s / 0.01;
     assert!(fraction > 0.45 && fraction < 0.5, "gas time {}", gas.time_s);
     let bottom = &gas.velocity_m_per_s[1][..4];
