@@ -12,8 +12,14 @@ contact.tangential (one of):
 contact.rolling (optional, default none):
   none
   constant_directional_torque                                            M = mu_r R* F_n; species.rolling_friction_coefficient
+cohesion (optional, one of):
+  liquid_bridge: { surface_tension_n_per_m, viscosity_pa_s?, min_gap_m? }  seed 000 eqs. 2.16-2.20, 6.1-6.44;
+                                                                         species.liquid_content, contact_angle_deg
+  hamaker: { constant_j, inner_cutoff_m, outer_cutoff_m, walls? }        seed 001 eqs. 6.34-6.37
+  square_well: { depth_j, outer_to_inner_radius_ratio, walls? }          seed 001 eqs. 3.6-3.11 as impulses
 species: { name, radius_m, density_kg_per_m3, youngs_modulus_pa, poisson_ratio, friction_coefficient,
-           yield_force_n?, rolling_friction_coefficient?, thermal_conductivity_w_per_m_k?, heat_capacity_j_per_kg_k? }
+           yield_force_n?, rolling_friction_coefficient?, thermal_conductivity_w_per_m_k?, heat_capacity_j_per_kg_k?,
+           contact_angle_deg?, liquid_content? }
 walls (list of):
   box: { species }                                                       planes on every non-periodic face
   plane: { name, species, point_m, normal }
@@ -31,6 +37,7 @@ time: { end_time_s, dt_s | dt_fraction_of_contact_time, reference_velocity_m_per
 #[cfg(test)]
 mod tests {
     use super::MODELS;
+    use crate::engine::models::cohesion_law::CohesionModel;
     use crate::engine::models::{ContactLaw, NormalModel, PlasticSlope, RollingModel, TangentialModel};
 
     /// Every model the enums define is listed, under the name the YAML and checkpoints use, and the listed forms
@@ -75,6 +82,16 @@ mod tests {
             for name in law.model_names() {
                 assert!(MODELS.contains(name));
             }
+        }
+        for yaml in [
+            "liquid_bridge: { surface_tension_n_per_m: 0.072, viscosity_pa_s: 0.001, min_gap_m: 1.0e-5 }",
+            "hamaker: { constant_j: 1.0e-18, inner_cutoff_m: 4.0e-10, outer_cutoff_m: 1.0e-4, walls: false }",
+            "square_well: { depth_j: 1.0e-10, outer_to_inner_radius_ratio: 1.01, walls: true }",
+        ] {
+            let de = serde_norway::Deserializer::from_str(yaml);
+            let model: CohesionModel =
+                serde_norway::with::singleton_map_recursive::deserialize(de).unwrap_or_else(|e| panic!("{yaml}: {e}"));
+            assert!(MODELS.contains(&format!("  {}: {{", model.name())));
         }
     }
 }

@@ -118,6 +118,42 @@ const CASES: &[(&str, &str, &str, &[&str])] = &[
         "end_time_s: 0.0",
         &["time.end_time_s"],
     ),
+    (
+        "liquid without liquid bridges",
+        "friction_coefficient: 0.3 }",
+        "friction_coefficient: 0.3, liquid_content: 0.01 }",
+        &["species[0].liquid_content", "liquid_bridge"],
+    ),
+    (
+        "contact angle of 95 degrees",
+        "friction_coefficient: 0.3 }\ncontact:",
+        "friction_coefficient: 0.3, contact_angle_deg: 95.0 }\ncohesion: { liquid_bridge: { surface_tension_n_per_m: 0.072 } }\ncontact:",
+        &["species[0].contact_angle_deg", "< 90"],
+    ),
+    (
+        "negative surface tension",
+        "time: {",
+        "cohesion: { liquid_bridge: { surface_tension_n_per_m: -0.072 } }\ntime: {",
+        &["cohesion.liquid_bridge.surface_tension_n_per_m", "> 0"],
+    ),
+    (
+        "Hamaker outer cutoff inside the inner one",
+        "time: {",
+        "cohesion: { hamaker: { constant_j: 1.0e-18, inner_cutoff_m: 4.0e-10, outer_cutoff_m: 1.0e-10 } }\ntime: {",
+        &["cohesion.hamaker.outer_cutoff_m", "inner_cutoff_m"],
+    ),
+    (
+        "square well narrower than the particle",
+        "time: {",
+        "cohesion: { square_well: { depth_j: 1.0e-10, outer_to_inner_radius_ratio: 0.99 } }\ntime: {",
+        &["cohesion.square_well.outer_to_inner_radius_ratio", "> 1"],
+    ),
+    (
+        "unknown cohesion model",
+        "time: {",
+        "cohesion: { capillary: { surface_tension_n_per_m: 0.072 } }\ntime: {",
+        &["bad.yaml:", "capillary"],
+    ),
 ];
 
 #[test]

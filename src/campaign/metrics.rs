@@ -2,6 +2,7 @@
 
 use super::JobSpec;
 use super::spec::CampaignSpec;
+use crate::engine::models::cohesion_law::CohesionModel;
 
 /// A metric a worker can reduce from its job.
 #[derive(Debug, Clone, Copy)]
@@ -14,6 +15,26 @@ pub struct MetricInfo {
     /// Needs a gas in the scenario.
     pub needs_gas: bool,
 }
+
+/// Needs a liquid-bridge cohesion model (the scenario's `cohesion: liquid_bridge`).
+const WET: &[&str] = &[
+    "granular_bond_number",
+    "granular_bond_number_22",
+    "granular_bond_number_12",
+    "granular_capillary_number",
+    "granular_capillary_number_22",
+    "granular_capillary_number_12",
+    "wet_phase_mixed",
+];
+
+/// Needs two species (1 = the first, 2 = the second).
+const BINARY: &[&str] = &[
+    "granular_bond_number_22",
+    "granular_bond_number_12",
+    "granular_capillary_number_22",
+    "granular_capillary_number_12",
+    "wet_phase_mixed",
+];
 
 pub const METRICS: &[MetricInfo] = &[
     MetricInfo {
@@ -122,6 +143,55 @@ pub const METRICS: &[MetricInfo] = &[
         needs_gas: true,
     },
     MetricInfo {
+        name: "granular_bond_number",
+        unit: "1",
+        description: "Bo_g = F_c,max/W of the first species, F_c,max = 2πRγ cos θ (seed 000 §4.1.1)",
+        needs_mixing: false,
+        needs_gas: false,
+    },
+    MetricInfo {
+        name: "granular_bond_number_22",
+        unit: "1",
+        description: "Bo_g of the second species",
+        needs_mixing: false,
+        needs_gas: false,
+    },
+    MetricInfo {
+        name: "granular_bond_number_12",
+        unit: "1",
+        description: "Bo_g12: the 1-2 pair's F_c,max over the lighter particle's weight (seed 000 §4.2.1)",
+        needs_mixing: false,
+        needs_gas: false,
+    },
+    MetricInfo {
+        name: "granular_capillary_number",
+        unit: "1",
+        description: "Ca_g = F_c,max/F_d of the first species, Di Felice drag at slip U/ε (seed 000 eq. 4.3; analysis.capillary_number_porosity)",
+        needs_mixing: false,
+        needs_gas: true,
+    },
+    MetricInfo {
+        name: "granular_capillary_number_22",
+        unit: "1",
+        description: "Ca_g of the second species",
+        needs_mixing: false,
+        needs_gas: true,
+    },
+    MetricInfo {
+        name: "granular_capillary_number_12",
+        unit: "1",
+        description: "Ca_g12: the pair's F_c,max over the drag of the species with the larger F_d/W (seed 000 eqs. 4.4-4.5)",
+        needs_mixing: false,
+        needs_gas: true,
+    },
+    MetricInfo {
+        name: "wet_phase_mixed",
+        unit: "1",
+        description: "seed 000's phase rule on Ca_g11, Ca_g22, Ca_g12: 1 = more mixed than dry (M), 0 = more segregated (S)",
+        needs_mixing: false,
+        needs_gas: true,
+    },
+    MetricInfo {
         name: "probe_pressure_drop_mean_pa",
         unit: "Pa",
         description: "time-averaged pressure drop from the inlet to gas.pressure_probe_height_m",
@@ -216,6 +286,32 @@ pub fn check_job(job: &JobSpec) -> Result<(), (String, String)> {
         return Err((
             format!("metrics[{p}]"),
             "`probe_pressure_drop_mean_pa` needs gas.pressure_probe_height_m".into(),
+        ));
+    }
+    let wet = matches!(job.scenario.cohesion, Some(CohesionModel::LiquidBridge(_)));
+    for (k, name) in job.metrics.iter().enumerate() {
+        if WET.contains(&name.as_str()) && !wet {
+            return Err((
+                format!("metrics[{k}]"),
+                format!("`{name}` needs liquid bridges (`cohesion: {{ liquid_bridge: ... }}` in the scenario)"),
+            ));
+        }
+        if BINARY.contains(&name.as_str()) && job.scenario.species.len() != 2 {
+            return Err((
+                format!("metrics[{k}]"),
+                format!(
+                    "`{name}` needs exactly two species (1 = the first, 2 = the second); the scenario has {}",
+                    job.scenario.species.len()
+                ),
+            ));
+        }
+    }
+    if let Some(eps) = job.analysis.capillary_number_porosity
+        && !(eps.is_finite() && eps > 0.0 && eps <= 1.0)
+    {
+        return Err((
+            "analysis.capillary_number_porosity".into(),
+            format!("expected 0 < value <= 1, got {eps}"),
         ));
     }
     if let Some(a) = &job.analysis.mixing_species

@@ -21,6 +21,7 @@ use xxhash_rust::xxh3::Xxh3Default;
 
 use super::{CheckpointError, CheckpointMeta};
 use crate::engine::Vec3;
+use crate::engine::cohesion::{CohesionState, CohesionStore};
 use crate::engine::contacts::{ContactStore, WallId};
 use crate::engine::gas::coupled::{GasSnapshot, GasStepStats};
 use crate::engine::models::ContactHistory;
@@ -51,6 +52,10 @@ pub(crate) enum Rows {
     GasFaces(u8),
     /// One value with a gas, none without (a 1-D dataset of length 0 or 1).
     GasScalar,
+    /// The number of particle pairs with a cohesion state (a liquid bridge or a square well).
+    CohesionPairs,
+    /// The number of particle–wall pairs with a cohesion state.
+    CohesionWalls,
 }
 
 /// One dataset of the layout.
@@ -217,6 +222,16 @@ datasets! {
     gas_last_linear_iterations: u64 => "gas/last_step/linear_iterations", Rows::GasScalar, 1, "1";
     gas_last_mass_imbalance: f64 => "gas/last_step/mass_imbalance", Rows::GasScalar, 1, "1";
     gas_last_converged: u8 => "gas/last_step/converged", Rows::GasScalar, 1, "1";
+
+    liquid_m3: f64 => "particles/liquid_m3", Rows::Particles, 1, "m3";
+    cohesion_pair_i: u32 => "cohesion/pairs/i", Rows::CohesionPairs, 1, "1";
+    cohesion_pair_j: u32 => "cohesion/pairs/j", Rows::CohesionPairs, 1, "1";
+    cohesion_pair_bridge_volume_m3: f64 => "cohesion/pairs/bridge_volume_m3", Rows::CohesionPairs, 1, "m3";
+    cohesion_pair_in_well: u8 => "cohesion/pairs/in_well", Rows::CohesionPairs, 1, "1";
+    cohesion_wall_i: u32 => "cohesion/walls/i", Rows::CohesionWalls, 1, "1";
+    cohesion_wall_wall: u16 => "cohesion/walls/wall", Rows::CohesionWalls, 1, "1";
+    cohesion_wall_bridge_volume_m3: f64 => "cohesion/walls/bridge_volume_m3", Rows::CohesionWalls, 1, "m3";
+    cohesion_wall_in_well: u8 => "cohesion/walls/in_well", Rows::CohesionWalls, 1, "1";
 }
 
 /// Groups to create before the datasets, parents first.
@@ -229,6 +244,9 @@ pub(crate) const GROUPS: &[&str] = &[
     "rng",
     "gas",
     "gas/last_step",
+    "cohesion",
+    "cohesion/pairs",
+    "cohesion/walls",
 ];
 
 /// The scalar part of a checkpoint: the root attributes other than `format` and the checksum.
@@ -375,6 +393,36 @@ impl Arrays {
             gas_last_linear_iterations: gas.map(|g| g.last.linear_iterations).into_iter().collect(),
             gas_last_mass_imbalance: gas.map(|g| g.last.mass_imbalance).into_iter().collect(),
             gas_last_converged: gas.map(|g| u8::from(g.last.converged)).into_iter().collect(),
+
+            liquid_m3: p.liquid_m3.clone(),
+            cohesion_pair_i: state.cohesion.pairs.iter().map(|(i, _, _)| i.0).collect(),
+            cohesion_pair_j: state.cohesion.pairs.iter().map(|(_, j, _)| j.0).collect(),
+            cohesion_pair_bridge_volume_m3: state
+                .cohesion
+                .pairs
+                .iter()
+                .map(|(_, _, c)| c.bridge_volume_m3)
+                .collect(),
+            cohesion_pair_in_well: state
+                .cohesion
+                .pairs
+                .iter()
+                .map(|(_, _, c)| u8::from(c.in_well))
+                .collect(),
+            cohesion_wall_i: state.cohesion.walls.iter().map(|(i, _, _)| i.0).collect(),
+            cohesion_wall_wall: state.cohesion.walls.iter().map(|(_, w, _)| w.0).collect(),
+            cohesion_wall_bridge_volume_m3: state
+                .cohesion
+                .walls
+                .iter()
+                .map(|(_, _, c)| c.bridge_volume_m3)
+                .collect(),
+            cohesion_wall_in_well: state
+                .cohesion
+                .walls
+                .iter()
+                .map(|(_, _, c)| u8::from(c.in_well))
+                .collect(),
         }
     }
 
@@ -391,6 +439,8 @@ impl Arrays {
             ("contacts/pairs/yielded", &self.pair_yielded),
             ("contacts/walls/active", &self.wall_active),
             ("contacts/walls/yielded", &self.wall_yielded),
+            ("cohesion/pairs/in_well", &self.cohesion_pair_in_well),
+            ("cohesion/walls/in_well", &self.cohesion_wall_in_well),
         ];
         for (path, values) in flags {
             if let Some(k) = values.iter().position(|&v| v > 1) {
@@ -401,6 +451,9 @@ impl Arrays {
             ("contacts/pairs/i", &self.pair_i),
             ("contacts/pairs/j", &self.pair_j),
             ("contacts/walls/i", &self.wall_i),
+            ("cohesion/pairs/i", &self.cohesion_pair_i),
+            ("cohesion/pairs/j", &self.cohesion_pair_j),
+            ("cohesion/walls/i", &self.cohesion_wall_i),
         ];
         for (path, values) in particles {
             if let Some(k) = values.iter().position(|&v| v as usize >= n) {
@@ -427,11 +480,16 @@ impl Arrays {
         if let Some(&v) = self.gas_last_converged.first().filter(|&&v| v > 1) {
             return Err(format!("/gas/last_step/converged is {v}, expected 0 or 1"));
         }
-        if let Some(k) = self.wall_wall.iter().position(|&w| w as usize >= n_walls) {
-            return Err(format!(
-                "/contacts/walls/wall[{k}] = {} is not a wall (there are {n_walls})",
-                self.wall_wall[k]
-            ));
+        for (path, values) in [
+            ("contacts/walls/wall", &self.wall_wall),
+            ("cohesion/walls/wall", &self.cohesion_wall_wall),
+        ] {
+            if let Some(k) = values.iter().position(|&w| w as usize >= n_walls) {
+                return Err(format!(
+                    "/{path}[{k}] = {} is not a wall (there are {n_walls})",
+                    values[k]
+                ));
+            }
         }
         Ok(())
     }
@@ -449,6 +507,31 @@ impl Arrays {
             angular_velocity_rad_per_s: unflatten(&self.angular_velocity_rad_per_s),
             force_n: unflatten(&self.force_n),
             torque_n_m: unflatten(&self.torque_n_m),
+            liquid_m3: self.liquid_m3,
+        };
+        let state_at = |volume: &[f64], in_well: &[u8], k: usize| CohesionState {
+            bridge_volume_m3: volume[k],
+            in_well: in_well[k] == 1,
+        };
+        let cohesion = CohesionStore {
+            pairs: (0..self.cohesion_pair_i.len())
+                .map(|k| {
+                    (
+                        ParticleId(self.cohesion_pair_i[k]),
+                        ParticleId(self.cohesion_pair_j[k]),
+                        state_at(&self.cohesion_pair_bridge_volume_m3, &self.cohesion_pair_in_well, k),
+                    )
+                })
+                .collect(),
+            walls: (0..self.cohesion_wall_i.len())
+                .map(|k| {
+                    (
+                        ParticleId(self.cohesion_wall_i[k]),
+                        WallId(self.cohesion_wall_wall[k]),
+                        state_at(&self.cohesion_wall_bridge_volume_m3, &self.cohesion_wall_in_well, k),
+                    )
+                })
+                .collect(),
         };
         let pairs = (0..self.pair_i.len())
             .map(|k| {
@@ -507,6 +590,7 @@ impl Arrays {
             particles,
             wall_angle_rad: self.wall_angle_rad,
             contacts: ContactStore { pairs, walls },
+            cohesion,
             rng: RngState {
                 seed,
                 stream: self.rng_stream[0],

@@ -31,7 +31,7 @@ use crate::engine::SimState;
 
 /// Version of the file layout. Bump it whenever a name, type, shape or the checksum definition changes; readers
 /// reject any other version with [`CheckpointError::Version`].
-pub const CHECKPOINT_FORMAT_VERSION: u32 = 2;
+pub const CHECKPOINT_FORMAT_VERSION: u32 = 3;
 
 /// Metadata stored beside the state.
 #[derive(Debug, Clone, PartialEq)]
@@ -410,6 +410,8 @@ fn expected_shape(spec: &DatasetSpec) -> String {
         Rows::GasCells => "gas cells".to_string(),
         Rows::GasFaces(a) => format!("gas faces normal to axis {a}"),
         Rows::GasScalar => "0 or 1".to_string(),
+        Rows::CohesionPairs => "cohesion pairs".to_string(),
+        Rows::CohesionWalls => "cohesion wall pairs".to_string(),
     };
     if spec.width == 1 {
         format!("[{rows}]")
@@ -422,6 +424,7 @@ fn expected_shape(spec: &DatasetSpec) -> String {
 mod tests {
     use super::*;
     use crate::engine::Vec3;
+    use crate::engine::cohesion::{CohesionState, CohesionStore};
     use crate::engine::contacts::{ContactStore, WallId};
     use crate::engine::models::ContactHistory;
     use crate::engine::particles::{ParticleId, Particles, SpeciesId};
@@ -462,6 +465,7 @@ mod tests {
             p.force_n.push(v(f * 1.0e-3 / 3.0, -9.81 * f, f64::MIN_POSITIVE));
             p.torque_n_m
                 .push(v(-1.0e-9 * f, f64::from_bits(0x7ff8_0000_dead_beef), f64::MAX / f));
+            p.liquid_m3.push(1.0e-12 / f);
         }
         p.position_m[2].x = DISTINCTIVE;
         let contacts = ContactStore {
@@ -486,6 +490,34 @@ mod tests {
             particles: p,
             wall_angle_rad: vec![0.25, -1.5e-7],
             contacts,
+            cohesion: CohesionStore {
+                pairs: vec![
+                    (
+                        ParticleId(0),
+                        ParticleId(2),
+                        CohesionState {
+                            bridge_volume_m3: 2.5e-13,
+                            in_well: false,
+                        },
+                    ),
+                    (
+                        ParticleId(3),
+                        ParticleId(4),
+                        CohesionState {
+                            bridge_volume_m3: 0.0,
+                            in_well: true,
+                        },
+                    ),
+                ],
+                walls: vec![(
+                    ParticleId(1),
+                    WallId(1),
+                    CohesionState {
+                        bridge_volume_m3: 0.0,
+                        in_well: true,
+                    },
+                )],
+            },
             rng: RngState {
                 seed,
                 stream: 0xdead_beef_1234_5678,
@@ -581,6 +613,7 @@ mod tests {
     fn empty_contacts_and_no_walls_round_trip() {
         let mut state = sample_state();
         state.contacts = ContactStore::default();
+        state.cohesion.walls.clear();
         state.wall_angle_rad.clear();
         let meta = CheckpointMeta {
             wall_names: Vec::new(),
@@ -596,6 +629,7 @@ mod tests {
         let mut state = sample_state();
         state.particles = Particles::default();
         state.contacts = ContactStore::default();
+        state.cohesion = CohesionStore::default();
         round_trip(&state, &sample_meta());
     }
 
@@ -1076,6 +1110,32 @@ mod tests {
             &gas.last.mass_imbalance.to_bits().to_le_bytes(),
         );
         ds(&mut b, "gas/last_step/converged", &[1], &[u8::from(gas.last.converged)]);
+        ds(&mut b, "particles/liquid_m3", &[n], &f(p.liquid_m3.iter().copied()));
+        type CohesionTable = (&'static str, Vec<u8>, Vec<u8>, Vec<CohesionState>);
+        let cohesion: [CohesionTable; 2] = [
+            (
+                "pairs",
+                state.cohesion.pairs.iter().flat_map(|c| c.0.0.to_le_bytes()).collect(),
+                state.cohesion.pairs.iter().flat_map(|c| c.1.0.to_le_bytes()).collect(),
+                state.cohesion.pairs.iter().map(|c| c.2).collect(),
+            ),
+            (
+                "walls",
+                state.cohesion.walls.iter().flat_map(|c| c.0.0.to_le_bytes()).collect(),
+                state.cohesion.walls.iter().flat_map(|c| c.1.0.to_le_bytes()).collect(),
+                state.cohesion.walls.iter().map(|c| c.2).collect(),
+            ),
+        ];
+        for (table, i, partner, c) in cohesion {
+            let m = c.len();
+            let partner_name = if table == "pairs" { "j" } else { "wall" };
+            ds(&mut b, &format!("cohesion/{table}/i"), &[m], &i);
+            ds(&mut b, &format!("cohesion/{table}/{partner_name}"), &[m], &partner);
+            let volume = f(c.iter().map(|x| x.bridge_volume_m3));
+            ds(&mut b, &format!("cohesion/{table}/bridge_volume_m3"), &[m], &volume);
+            let in_well: Vec<u8> = c.iter().map(|x| u8::from(x.in_well)).collect();
+            ds(&mut b, &format!("cohesion/{table}/in_well"), &[m], &in_well);
+        }
 
         assert_eq!(stored, xxhash_rust::xxh3::xxh3_64(&b));
     }

@@ -2,6 +2,7 @@
 //! join. It knows nothing about campaigns; `Simulation` is driven by `crate::run` (the `simulate` command) and,
 //! later, by workers.
 
+pub mod cohesion;
 pub mod contacts;
 pub mod error;
 pub mod forces;

@@ -16,6 +16,14 @@ use super::geometry::{Domain, Wall};
 /// Particles per parallel work item in the build.
 pub const BUILD_CHUNK: usize = 1024;
 
+/// How far beyond contact particles interact with each other and with walls (a cohesion model's range): the list
+/// holds every pair whose surfaces are closer than this plus the skin.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct Reach {
+    pub pair_gap_m: f64,
+    pub wall_gap_m: f64,
+}
+
 #[derive(Debug, Clone, Default)]
 pub struct NeighborList {
     pub start: Vec<u32>,
@@ -154,7 +162,7 @@ impl NeighborList {
     }
 
     /// Rebuilds the lists for particles of radius `radius` at `position`. Pairs are candidates when their surfaces
-    /// are closer than `skin_m`; particle–wall pairs likewise, except that in a `pseudo_2d` run a plane normal to z
+    /// are closer than `range.pair_gap_m + skin_m`; particle–wall pairs likewise (with `range.wall_gap_m`), except that in a `pseudo_2d` run a plane normal to z
     /// is a candidate only if the particle already overlaps it (its gap cannot change: in a one-layer bed every
     /// particle just touches the front and back planes, which never push).
     #[allow(clippy::too_many_arguments)]
@@ -164,13 +172,14 @@ impl NeighborList {
         position: &[Vec3],
         radius: &[f64],
         skin_m: f64,
+        range: Reach,
         walls: &[Wall],
         wall_angle: &[f64],
         pseudo_2d: bool,
     ) {
         let n = position.len();
         let max_radius = radius.iter().copied().fold(0.0, f64::max);
-        let grid = CellGrid::new(domain, position, 2.0 * max_radius + skin_m);
+        let grid = CellGrid::new(domain, position, 2.0 * max_radius + range.pair_gap_m + skin_m);
 
         struct Chunk {
             partners: Vec<u32>,
@@ -205,7 +214,7 @@ impl NeighborList {
                                     if j <= i {
                                         continue;
                                     }
-                                    let reach = ri + radius[j] + skin_m;
+                                    let reach = ri + radius[j] + range.pair_gap_m + skin_m;
                                     if domain.separation(&xi, &position[j]).norm_squared() < reach * reach {
                                         out.partners.push(j as u32);
                                     }
@@ -220,7 +229,7 @@ impl NeighborList {
                         let reach = if pseudo_2d && wall.is_plane_normal_to_z() {
                             ri
                         } else {
-                            ri + skin_m
+                            ri + range.wall_gap_m + skin_m
                         };
                         if wall.proximity(&xi, wall_angle[w]).gap_m < reach {
                             out.walls.push(w as u16);
@@ -297,7 +306,7 @@ mod tests {
                 .collect();
             let radius: Vec<f64> = (0..n).map(|_| 0.02 + 0.02 * rnd()).collect();
             let mut list = NeighborList::default();
-            list.build(&domain, &position, &radius, 0.01, &[], &[], false);
+            list.build(&domain, &position, &radius, 0.01, Reach::default(), &[], &[], false);
             for i in 0..n {
                 let mut expected = vec![];
                 for j in i + 1..n {

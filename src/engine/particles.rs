@@ -54,6 +54,13 @@ pub struct Species {
     pub thermal_conductivity_w_per_m_k: Option<f64>,
     #[serde(default)]
     pub heat_capacity_j_per_kg_k: Option<f64>,
+    /// Contact angle θ of the cohesion model's liquid on this material, degrees (liquid bridges; default 0).
+    #[serde(default)]
+    pub contact_angle_deg: f64,
+    /// Liquid each particle of this species carries at the start, as V̂ = V/R³ (liquid bridges; seed 000 sprays
+    /// up to 0.02; default 0: dry).
+    #[serde(default)]
+    pub liquid_content: f64,
 }
 
 impl Species {
@@ -106,6 +113,8 @@ pub struct Particles {
     /// half-kick of the next step needs it.
     pub force_n: Vec<Vec3>,
     pub torque_n_m: Vec<Vec3>,
+    /// Liquid carried on the particle's surface (not in bridges), m³.
+    pub liquid_m3: Vec<f64>,
 }
 
 impl Particles {
@@ -131,6 +140,7 @@ impl Particles {
         self.angular_velocity_rad_per_s.push(Vec3::zeros());
         self.force_n.push(Vec3::zeros());
         self.torque_n_m.push(Vec3::zeros());
+        self.liquid_m3.push(species.liquid_content * radius_m.powi(3));
         id
     }
 
@@ -160,7 +170,11 @@ impl Particles {
         let v3 = std::mem::size_of::<Vec3>();
         self.id.capacity() * 4
             + self.species.capacity() * 2
-            + (self.radius_m.capacity() + self.mass_kg.capacity() + self.inertia_kg_m2.capacity()) * 8
+            + (self.radius_m.capacity()
+                + self.mass_kg.capacity()
+                + self.inertia_kg_m2.capacity()
+                + self.liquid_m3.capacity())
+                * 8
             + (self.position_m.capacity()
                 + self.velocity_m_per_s.capacity()
                 + self.angular_velocity_rad_per_s.capacity()

@@ -8,13 +8,14 @@
 use std::sync::Arc;
 use std::time::{Duration, Instant};
 
+use super::cohesion::{AlignedCohesion, Cohesion, CohesionPass, apply_cohesion, total_liquid_m3};
 use super::contacts::AlignedHistory;
 use super::forces::{ForcePass, HalfKick, PairBuffers, RangePlan, compute_contact_forces};
 use super::gas::coupled::GasCoupling;
 use super::geometry::{Domain, Gravity, Wall};
 use super::integrate::{InverseInertia, find_lost, kick_drift};
 use super::models::{ContactLaw, PairTable};
-use super::neighbor::NeighborList;
+use super::neighbor::{NeighborList, Reach};
 use super::particles::{ParticleId, Particles, SpeciesTable};
 use super::state::{RngState, SimState};
 use super::team::Team;
@@ -43,6 +44,18 @@ pub struct SimConfig {
     pub skin_m: f64,
     /// Largest tolerated overlap as a fraction of the smaller radius; beyond it the step fails.
     pub max_overlap_fraction: f64,
+    /// Forces at a distance (liquid bridges, van der Waals, square well); `None`: dry, cohesionless particles.
+    pub cohesion: Option<Cohesion>,
+}
+
+impl SimConfig {
+    /// How far beyond contact the neighbour list must reach for the cohesion model.
+    pub fn reach(&self) -> Reach {
+        self.cohesion.as_ref().map_or(Reach::default(), |c| Reach {
+            pair_gap_m: c.range_m,
+            wall_gap_m: c.wall_range_m,
+        })
+    }
 }
 
 /// Wall-clock time spent per stage.
@@ -55,6 +68,8 @@ pub struct StageTimers {
     pub gas: Duration,
     /// The gas's forces on the particles and their reaction (inside `force`).
     pub fluid_forces: Duration,
+    /// The cohesion pass (inside `force`).
+    pub cohesion: Duration,
 }
 
 pub struct Simulation {
@@ -67,6 +82,10 @@ pub struct Simulation {
     pub rng: RngState,
     list: NeighborList,
     history: AlignedHistory,
+    /// Cohesion states (bridges, wells), aligned with `list` like `history`.
+    cohesion: AlignedCohesion,
+    /// Events of the cohesion passes since the start of this process.
+    pub cohesion_events: CohesionPass,
     buffers: PairBuffers,
     inverse: InverseInertia,
     /// Particle ranges of the parallel force pass, rebalanced at every neighbour-list build.
@@ -110,6 +129,8 @@ impl Simulation {
             rng,
             list: NeighborList::default(),
             history: AlignedHistory::default(),
+            cohesion: AlignedCohesion::default(),
+            cohesion_events: CohesionPass::default(),
             buffers: PairBuffers::default(),
             inverse,
             ranges: RangePlan::default(),
@@ -123,6 +144,7 @@ impl Simulation {
         };
         sim.refresh_neighbors();
         // The first half kick needs F(0). With dt = 0 the tangential springs do not move.
+        sim.apply_cohesion(0.0);
         let pass = sim.forces(0.0, None);
         sim.check_overlap(pass.worst_overlap)?;
         Ok(sim)
@@ -141,6 +163,8 @@ impl Simulation {
             rng: state.rng,
             list: NeighborList::default(),
             history: AlignedHistory::default(),
+            cohesion: AlignedCohesion::default(),
+            cohesion_events: CohesionPass::default(),
             buffers: PairBuffers::default(),
             inverse,
             ranges: RangePlan::default(),
@@ -158,6 +182,7 @@ impl Simulation {
                 &sim.particles.position_m,
                 &sim.particles.radius_m,
                 sim.config.skin_m,
+                sim.config.reach(),
                 &sim.config.walls,
                 &sim.wall_angle_rad,
                 sim.config.pseudo_2d,
@@ -169,6 +194,11 @@ impl Simulation {
             return Err(NumericalError::OrphanContacts { count: orphans });
         }
         sim.history = history;
+        let (cohesion, orphans) = AlignedCohesion::from_store(&state.cohesion, &sim.list, &mut sim.particles.liquid_m3);
+        if orphans > 0 {
+            return Err(NumericalError::OrphanContacts { count: orphans });
+        }
+        sim.cohesion = cohesion;
         sim.rebalance();
         Ok(sim)
     }
@@ -182,6 +212,7 @@ impl Simulation {
             particles: self.particles.clone(),
             wall_angle_rad: self.wall_angle_rad.clone(),
             contacts: self.history.to_store(&self.list),
+            cohesion: self.cohesion.to_store(&self.list),
             rng: self.rng,
             gas: self.gas.as_ref().map(|g| g.snapshot()),
         }
@@ -199,8 +230,9 @@ impl Simulation {
             ("dem_neighbor".into(), self.timers.neighbor.as_secs_f64()),
             (
                 "dem_contact_forces".into(),
-                (self.timers.force - self.timers.fluid_forces).as_secs_f64(),
+                (self.timers.force - self.timers.fluid_forces - self.timers.cohesion).as_secs_f64(),
             ),
+            ("dem_cohesion".into(), self.timers.cohesion.as_secs_f64()),
             (
                 "fluid_forces_on_particles".into(),
                 self.timers.fluid_forces.as_secs_f64(),
@@ -360,6 +392,7 @@ impl Simulation {
             fluid.add_forces(&p.position_m, &p.velocity_m_per_s, &p.radius_m, &mut p.force_n, team);
             self.timers.fluid_forces += t.elapsed();
         }
+        self.apply_cohesion(dt);
         let kick = HalfKick {
             gravity: config.gravity.at(self.time_s),
             dt_s: dt,
@@ -437,6 +470,38 @@ impl Simulation {
         pass
     }
 
+    /// Adds the cohesion forces to the force arrays (zeroing them first if the last pass left them holding its
+    /// forces), so that the contact pass completes them.
+    fn apply_cohesion(&mut self, dt: f64) {
+        let Some(cohesion) = self.config.cohesion.as_ref() else {
+            return;
+        };
+        let t = Instant::now();
+        if !self.accumulators_zeroed {
+            self.particles.force_n.iter_mut().for_each(|f| *f = Vec3::zeros());
+            self.particles.torque_n_m.iter_mut().for_each(|t| *t = Vec3::zeros());
+            self.accumulators_zeroed = true;
+        }
+        let pass = apply_cohesion(
+            cohesion,
+            &self.config,
+            &mut self.particles,
+            &self.list,
+            &mut self.cohesion,
+            &self.wall_angle_rad,
+            dt,
+        );
+        self.cohesion_events.bridges_formed += pass.bridges_formed;
+        self.cohesion_events.bridges_ruptured += pass.bridges_ruptured;
+        self.cohesion_events.well_crossings += pass.well_crossings;
+        self.timers.cohesion += t.elapsed();
+    }
+
+    /// Liquid on the particles plus liquid in bridges, m³.
+    pub fn total_liquid_m3(&self) -> f64 {
+        total_liquid_m3(&self.particles.liquid_m3, &self.cohesion)
+    }
+
     fn rebalance(&mut self) {
         self.ranges = RangePlan::balanced(
             &self.list,
@@ -459,6 +524,7 @@ impl Simulation {
                 &s.particles.position_m,
                 &s.particles.radius_m,
                 c.skin_m,
+                c.reach(),
                 &c.walls,
                 &s.wall_angle_rad,
                 c.pseudo_2d,
@@ -468,6 +534,13 @@ impl Simulation {
         // A contact is always a candidate of a list built from the same positions.
         debug_assert_eq!(orphans, 0, "contacts lost in a neighbour-list rebuild");
         self.history = history;
+        if self.config.cohesion.is_some() {
+            let store = self.cohesion.to_store(&old_list);
+            let (cohesion, orphans) = AlignedCohesion::from_store(&store, &self.list, &mut self.particles.liquid_m3);
+            // A bridge or well pair is always within the cohesion reach, hence a candidate.
+            debug_assert_eq!(orphans, 0, "cohesion states lost in a neighbour-list rebuild");
+            self.cohesion = cohesion;
+        }
         self.rebalance();
     }
 

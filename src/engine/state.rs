@@ -6,10 +6,11 @@ use rand_chacha::ChaCha8Rng;
 use rand_chacha::rand_core::SeedableRng;
 
 use super::Vec3;
+use super::cohesion::{CohesionState, CohesionStore};
 use super::contacts::ContactStore;
 use super::gas::coupled::GasSnapshot;
 use super::models::ContactHistory;
-use super::particles::Particles;
+use super::particles::{ParticleId, Particles};
 
 /// The complete state of a ChaCha8 generator: seed, stream and position.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -51,6 +52,8 @@ pub struct SimState {
     /// Angle turned by each wall (0 for static walls), rad.
     pub wall_angle_rad: Vec<f64>,
     pub contacts: ContactStore,
+    /// Liquid bridges and square-well pairs (empty without a cohesion model).
+    pub cohesion: CohesionStore,
     pub rng: RngState,
     /// The gas of a coupled run.
     pub gas: Option<GasSnapshot>,
@@ -233,4 +236,31 @@ pub fn first_difference(a: &SimState, b: &SimState) -> Option<String> {
                     history(&format!("contacts.walls[{k}] ({}, wall {})", x.0.0, x.1.0), &x.2, &y.2)
                 })
         })
+        .or_else(|| scalars("particles.liquid_m3", &p.liquid_m3, &q.liquid_m3))
+        .or_else(|| cohesion_difference(&a.cohesion, &b.cohesion))
+}
+
+fn cohesion_difference(a: &CohesionStore, b: &CohesionStore) -> Option<String> {
+    fn states<K: PartialEq + std::fmt::Debug>(
+        name: &str,
+        x: &[(ParticleId, K, CohesionState)],
+        y: &[(ParticleId, K, CohesionState)],
+    ) -> Option<String> {
+        if x.len() != y.len() {
+            return Some(format!("{name}: {} vs {} entries", x.len(), y.len()));
+        }
+        x.iter().zip(y).enumerate().find_map(|(k, (p, q))| {
+            if p.0 != q.0 || p.1 != q.1 {
+                return Some(format!(
+                    "{name}[{k}]: key ({}, {:?}) vs ({}, {:?})",
+                    p.0.0, p.1, q.0.0, q.1
+                ));
+            }
+            if p.2.bridge_volume_m3.to_bits() != q.2.bridge_volume_m3.to_bits() || p.2.in_well != q.2.in_well {
+                return Some(format!("{name}[{k}] ({}, {:?}): {:?} vs {:?}", p.0.0, p.1, p.2, q.2));
+            }
+            None
+        })
+    }
+    states("cohesion.pairs", &a.pairs, &b.pairs).or_else(|| states("cohesion.walls", &a.walls, &b.walls))
 }

@@ -12,7 +12,9 @@ use rand::RngExt;
 use super::ConfigError;
 use super::spec::{BaffleSpec, FillSpec, ScenarioSpec, WallSpec};
 use crate::engine::Vec3;
+use crate::engine::cohesion::Cohesion;
 use crate::engine::geometry::{Domain, RotatingFrame, Wall, WallShape};
+use crate::engine::models::cohesion_law::CohesionModel;
 use crate::engine::models::{ContactLaw, NormalModel, PairTable, TangentialModel};
 use crate::engine::particles::{Particles, SpeciesId, SpeciesTable};
 use crate::engine::simulation::SimConfig;
@@ -230,6 +232,20 @@ pub fn build(spec: ScenarioSpec, path: &Path) -> Result<BuiltScenario, ConfigErr
             )?)
         }
     };
+    let cohesion = match spec.cohesion {
+        None => None,
+        Some(model) => Some(
+            Cohesion::new(model, &species, particles.max_radius_m()).map_err(|(key, message)| c.fail(key, message))?,
+        ),
+    };
+    if !matches!(spec.cohesion, Some(CohesionModel::LiquidBridge(_)))
+        && let Some(k) = spec.species.iter().position(|s| s.liquid_content != 0.0)
+    {
+        return Err(c.fail(
+            format!("species[{k}].liquid_content"),
+            "liquid on the particles needs `cohesion: { liquid_bridge: ... }`",
+        ));
+    }
     let config = SimConfig {
         domain,
         pseudo_2d: spec.pseudo_2d,
@@ -240,6 +256,7 @@ pub fn build(spec: ScenarioSpec, path: &Path) -> Result<BuiltScenario, ConfigErr
         walls,
         skin_m,
         max_overlap_fraction: spec.max_overlap_fraction,
+        cohesion,
     };
     Ok(BuiltScenario {
         rng: RngState::capture(&rng),

@@ -37,6 +37,10 @@ pub struct ScenarioSpec {
     /// A gas coupled to the particles (fluidized beds); absent: particles in vacuum.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub gas: Option<super::gas::GasSpec>,
+    /// Forces at a distance between particles: liquid bridges, Hamaker van der Waals or the square well; absent:
+    /// dry, cohesionless particles.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub cohesion: Option<crate::engine::models::cohesion_law::CohesionModel>,
 }
 
 fn default_max_overlap_fraction() -> f64 {

@@ -8,6 +8,8 @@ use crate::analysis;
 use crate::campaign::JobSpec;
 use crate::campaign::metrics::info;
 use crate::engine::Simulation;
+use crate::engine::gas::grid::{Boundary, side};
+use crate::engine::models::cohesion_law::CohesionModel;
 use crate::engine::particles::SpeciesId;
 use crate::error::Error;
 use crate::scenario::BuiltScenario;
@@ -191,6 +193,7 @@ pub fn metrics(job: &JobSpec, built: &BuiltScenario, sim: &Simulation, series: &
             "probe_pressure_drop_mean_pa" => {
                 window(series, "probe_pressure_drop_pa", average_from_s).map_or(f64::NAN, |w| mean(&w))
             }
+            wet if wet.starts_with("granular_") || wet == "wet_phase_mixed" => wet_number(wet, job, built, sim),
             other => return Err(Error::External(format!("metric `{other}` has no reducer"))),
         };
         out.push(Metric {
@@ -223,6 +226,74 @@ fn mean(v: &[f64]) -> f64 {
 fn std_dev(v: &[f64]) -> f64 {
     let m = mean(v);
     (v.iter().map(|x| (x - m) * (x - m)).sum::<f64>() / v.len() as f64).sqrt()
+}
+
+/// The granular Bond and capillary numbers of the scenario's liquid and species (1 = the first species, 2 = the
+/// second), and seed 000's phase rule; NaN where the scenario lacks what they need (checked before the run).
+fn wet_number(name: &str, job: &JobSpec, built: &BuiltScenario, sim: &Simulation) -> f64 {
+    use crate::analysis::dimensionless::{
+        GasSlip, WetParticle, WetPhase, binary_granular_bond_number, binary_granular_capillary_number,
+        granular_bond_number, granular_capillary_number, wet_phase,
+    };
+    let Some(CohesionModel::LiquidBridge(bridge)) = built.spec.cohesion else {
+        return f64::NAN;
+    };
+    let gamma = bridge.surface_tension_n_per_m;
+    let g = built.spec.gravity.vector_m_per_s2;
+    let g = (g[0] * g[0] + g[1] * g[1] + g[2] * g[2]).sqrt();
+    let kind = |k: usize| {
+        built.spec.species.get(k).map(|s| WetParticle {
+            radius_m: s.radius_m,
+            density_kg_per_m3: s.density_kg_per_m3,
+            contact_angle_rad: s.contact_angle_deg.to_radians(),
+        })
+    };
+    let (Some(a), b) = (kind(0), kind(1)) else {
+        return f64::NAN;
+    };
+    let porosity = job.analysis.capillary_number_porosity.unwrap_or(0.55);
+    let gas = built
+        .spec
+        .gas
+        .as_ref()
+        .zip(inlet_velocity_m_per_s(sim))
+        .map(|(gas, u)| GasSlip {
+            density_kg_per_m3: gas.density_kg_per_m3,
+            viscosity_pa_s: gas.viscosity_pa_s,
+            slip_speed_m_per_s: u / porosity,
+            porosity,
+        });
+    let value = match (name, b, gas) {
+        ("granular_bond_number", _, _) => Some(granular_bond_number(&a, gamma, g)),
+        ("granular_bond_number_22", Some(b), _) => Some(granular_bond_number(&b, gamma, g)),
+        ("granular_bond_number_12", Some(b), _) => Some(binary_granular_bond_number(&a, &b, gamma, g)),
+        ("granular_capillary_number", _, Some(gas)) => Some(granular_capillary_number(&a, gamma, &gas)),
+        ("granular_capillary_number_22", Some(b), Some(gas)) => Some(granular_capillary_number(&b, gamma, &gas)),
+        ("granular_capillary_number_12", Some(b), Some(gas)) => {
+            Some(binary_granular_capillary_number(&a, &b, gamma, &gas, g))
+        }
+        ("wet_phase_mixed", Some(b), Some(gas)) => {
+            let phase = wet_phase(
+                granular_capillary_number(&a, gamma, &gas),
+                granular_capillary_number(&b, gamma, &gas),
+                binary_granular_capillary_number(&a, &b, gamma, &gas, g),
+            );
+            Some(if phase == WetPhase::Mixed { 1.0 } else { 0.0 })
+        }
+        _ => None,
+    };
+    value.unwrap_or(f64::NAN)
+}
+
+/// The superficial velocity of the gas entering through the inlet side, m/s (the magnitude of the prescribed
+/// inflow; `None` without a gas or an inlet side).
+fn inlet_velocity_m_per_s(sim: &Simulation) -> Option<f64> {
+    let gas = sim.gas.as_ref()?;
+    let (axis, high) = gas.inlet_side()?;
+    match gas.solver.config.grid.boundary[side(axis, high)] {
+        Boundary::Inlet { velocity_m_per_s } => Some(velocity_m_per_s.iter().map(|v| v * v).sum::<f64>().sqrt()),
+        _ => None,
+    }
 }
 
 /// W/A: the particles' weight over the area of the inlet side (seed 000 eq 2.74).

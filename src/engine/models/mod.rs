@@ -3,6 +3,7 @@
 
 pub mod capillary;
 pub mod cohesion;
+pub mod cohesion_law;
 pub mod contact_law;
 pub mod drag;
 pub mod history;

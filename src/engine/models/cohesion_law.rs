@@ -1,0 +1,153 @@
+//! The cohesion slot: one optional model of the forces particles exert on each other at a distance, beside the
+//! contact law. Liquid bridges (seed 000 §2.1.1–2.1.2, ch. 6), Hamaker van der Waals and the square well (seed 001
+//! §6.2.4). The pass that applies them, with the per-pair state they carry, is `engine::cohesion`.
+
+use serde::{Deserialize, Serialize};
+
+use super::cohesion::{Hamaker, SquareWell};
+
+/// A cohesion model, chosen by name in the scenario's `cohesion:` key.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize, schemars::JsonSchema)]
+#[serde(rename_all = "snake_case", deny_unknown_fields)]
+pub enum CohesionModel {
+    /// Pendular liquid bridges: Mikami's capillary force, the viscous forces of the liquid, the bridge volume taken
+    /// from both particles on contact and shared back on rupture. The liquid each particle carries at the start and
+    /// its contact angle are species properties (`liquid_content`, `contact_angle_deg`).
+    LiquidBridge(LiquidBridge),
+    /// Hamaker van der Waals attraction with an inner cutoff (seed 001 eqs 6.34–6.37).
+    Hamaker(HamakerCohesion),
+    /// Square well applied as impulses when a pair crosses the well's edge (seed 001 §6.2.4.2).
+    SquareWell(SquareWellCohesion),
+}
+
+/// Liquid bridge parameters.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize, schemars::JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct LiquidBridge {
+    /// Surface tension γ of the liquid, N/m (water: 0.072).
+    pub surface_tension_n_per_m: f64,
+    /// Dynamic viscosity μ of the liquid, Pa s (water: 1e-3); 0 leaves out the viscous forces (2.19–2.20).
+    #[serde(default)]
+    pub viscosity_pa_s: f64,
+    /// Smallest gap the viscous forces see (surface roughness), m: they use max(S, this). Default 1 % of the
+    /// smallest particle radius.
+    #[serde(default)]
+    pub min_gap_m: Option<f64>,
+}
+
+/// Hamaker parameters; the force acts between surfaces closer than `outer_cutoff_m`.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize, schemars::JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct HamakerCohesion {
+    /// Hamaker constant A, J.
+    pub constant_j: f64,
+    /// Inner cutoff H_cut, m (seed 001: 4e-10 m).
+    pub inner_cutoff_m: f64,
+    /// Gap beyond which the attraction is left out, m. Seed 001 names no outer cutoff; the force there is
+    /// (H_cut/H)² of its largest value (1.6e-11 at H = 0.1 mm).
+    pub outer_cutoff_m: f64,
+    /// Also between particles and walls (eq 6.36: twice the sphere–sphere value). Default true.
+    #[serde(default = "yes")]
+    pub walls: bool,
+}
+
+/// Square-well parameters.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize, schemars::JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct SquareWellCohesion {
+    /// Well depth D, J.
+    pub depth_j: f64,
+    /// r_outer / r_inner (seed 001's beds: 1.01): a pair is in the well while its centres are closer than
+    /// ratio × (R_i + R_j).
+    pub outer_to_inner_radius_ratio: f64,
+    /// Also between particles and walls, with the depth doubled and the wall's mass infinite (seed 001 §6.2.4.2).
+    /// Default true.
+    #[serde(default = "yes")]
+    pub walls: bool,
+}
+
+fn yes() -> bool {
+    true
+}
+
+impl HamakerCohesion {
+    pub fn law(&self) -> Hamaker {
+        Hamaker {
+            constant_j: self.constant_j,
+            cutoff_m: self.inner_cutoff_m,
+        }
+    }
+}
+
+impl SquareWellCohesion {
+    pub fn well(&self) -> SquareWell {
+        SquareWell {
+            depth_j: self.depth_j,
+            outer_to_inner_radius_ratio: self.outer_to_inner_radius_ratio,
+        }
+    }
+}
+
+impl CohesionModel {
+    pub fn name(&self) -> &'static str {
+        match self {
+            CohesionModel::LiquidBridge(_) => "liquid_bridge",
+            CohesionModel::Hamaker(_) => "hamaker",
+            CohesionModel::SquareWell(_) => "square_well",
+        }
+    }
+
+    /// Whether the model acts between particles and walls. Liquid bridges do not (seed 000 leaves them out to
+    /// avoid wall effects in small beds).
+    pub fn acts_on_walls(&self) -> bool {
+        match self {
+            CohesionModel::LiquidBridge(_) => false,
+            CohesionModel::Hamaker(h) => h.walls,
+            CohesionModel::SquareWell(w) => w.walls,
+        }
+    }
+}
+
+/// Square-well crossing impulse on the pair's relative normal motion (seed 001 eqs 3.6–3.11 with the reduced mass
+/// μ in place of m/2, so that a wall, of infinite mass, has μ = m_i): the change of the relative normal speed
+/// `approach_m_per_s` (= −(v_i − v_j)·n with n from j to i: positive while approaching) when the pair crosses the
+/// well's edge. `entering`: the pair arrives from outside and gains 2D/μ of squared speed (3.6); otherwise it is
+/// leaving and either escapes, losing 2D/μ (3.8), or is captured and reflected (3.10). Returns the new approach
+/// speed and whether the pair is now inside the well (entered or captured).
+pub fn square_well_crossing(depth_j: f64, reduced_mass_kg: f64, approach_m_per_s: f64, entering: bool) -> (f64, bool) {
+    let energy = 2.0 * depth_j / reduced_mass_kg;
+    if entering {
+        ((approach_m_per_s * approach_m_per_s + energy).sqrt(), true)
+    } else {
+        let left = approach_m_per_s * approach_m_per_s - energy;
+        if left > 0.0 {
+            // Escaping: still separating (negative approach speed), slower.
+            (-left.sqrt(), false)
+        } else {
+            // Captured: the separation speed reverses.
+            (-approach_m_per_s, true)
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The crossing conserves the pair's relative normal energy plus the well: entering gains D, escaping loses D,
+    /// capture keeps it (seed 001 §3).
+    #[test]
+    fn square_well_crossings_balance_energy() {
+        let (depth, mu) = (1e-10, 1e-6);
+        let (v, inside) = square_well_crossing(depth, mu, 0.01, true);
+        assert!(inside);
+        assert!((0.5 * mu * (v * v - 0.01 * 0.01) / depth - 1.0).abs() < 1e-9);
+        let (v_out, inside) = square_well_crossing(depth, mu, -0.05, false);
+        assert!(!inside && v_out < 0.0);
+        assert!((0.5 * mu * (0.05 * 0.05 - v_out * v_out) / depth - 1.0).abs() < 1e-9);
+        // Below the escape speed √(2D/μ) ≈ 0.0141 m/s the pair is captured and turns round.
+        let (v_back, inside) = square_well_crossing(depth, mu, -0.01, false);
+        assert!(inside);
+        assert_eq!(v_back, 0.01);
+    }
+}

@@ -1,0 +1,266 @@
+//! The cohesion pass in running simulations: liquid conservation while bridges form and break (VALIDATION B4),
+//! exact restart and thread-count independence with bridges and wells, and analytic checks of the capillary,
+//! Hamaker and square-well forces on particle pairs.
+
+mod common;
+
+use std::f64::consts::PI;
+use std::path::Path;
+
+use common::{built, granflow, simulation};
+use granflow::checkpoint::CheckpointSeries;
+use granflow::engine::models::capillary::mikami_force_n;
+use granflow::engine::state::{SimState, first_difference};
+
+/// A wet rotating drum: two species of 3 mm beads (contact angles 20° and 50°) carrying V̂ = 0.01 of water each,
+/// the lattice collapsing into the drum's bed while it turns.
+const WET_DRUM: &str = r#"
+name: wet-drum
+domain: { lo_m: [-0.041, -0.041, 0.0], hi_m: [0.041, 0.041, 0.012], periodic: [false, false, true] }
+gravity: { vector_m_per_s2: [0.0, -9.81, 0.0] }
+species:
+  - { name: a, radius_m: 0.0015, density_kg_per_m3: 2500.0, youngs_modulus_pa: 5.0e7, poisson_ratio: 0.3, friction_coefficient: 0.4, contact_angle_deg: 20.0, liquid_content: 0.01 }
+  - { name: b, radius_m: 0.0015, density_kg_per_m3: 2500.0, youngs_modulus_pa: 5.0e7, poisson_ratio: 0.3, friction_coefficient: 0.4, contact_angle_deg: 50.0, liquid_content: 0.01 }
+contact: { normal: { hertz: { restitution: 0.6 } }, tangential: mindlin }
+cohesion: { liquid_bridge: { surface_tension_n_per_m: 0.072, viscosity_pa_s: 0.001 } }
+walls:
+  - drum:
+      name: drum
+      species: a
+      axis_point_m: [0.0, 0.0, 0.0]
+      axis: [0.0, 0.0, 1.0]
+      radius_m: 0.04
+      rotation_rpm: 120.0
+      baffles:
+        - traditional: { count: 4, length_m: 0.01, half_thickness_m: 0.001, tilt_deg: 0.0 }
+fill:
+  - lattice: { species: a, spacing_m: 0.0032, lo_m: [-0.04, -0.04, 0.0], hi_m: [-0.001, 0.01, 0.0105], origin_m: [0.0, 0.0, 0.0015], inside_drum: drum }
+  - lattice: { species: b, spacing_m: 0.0032, lo_m: [0.0, -0.04, 0.0], hi_m: [0.04, 0.01, 0.0105], origin_m: [0.0, 0.0, 0.0015], inside_drum: drum }
+time: { dt_s: 1.0e-5, end_time_s: 0.08 }
+output: { checkpoint_every_steps: 2000, keep_checkpoints: 2, series_every_steps: 500 }
+seed: 5
+"#;
+
+fn liquid(state: &SimState) -> f64 {
+    state.particles.liquid_m3.iter().sum::<f64>() + state.cohesion.bridge_liquid_m3()
+}
+
+/// VALIDATION B4 (bridges; spray and evaporation are not built yet): the particles' liquid plus the bridges'
+/// volume stays what the particles started with, to 1e-10 relative, while thousands of bridges form and break
+/// between particles of unequal wettability.
+#[test]
+fn b4_liquid_is_conserved_while_bridges_form_and_break() {
+    let b = built(WET_DRUM);
+    let start: f64 = b.particles.liquid_m3.iter().sum();
+    assert!(start > 0.0);
+    let mut sim = simulation(&b, 2);
+    let mut worst: f64 = 0.0;
+    for _ in 0..8 {
+        sim.run_steps(1000).expect("stable");
+        let s = sim.snapshot();
+        worst = worst.max((liquid(&s) / start - 1.0).abs());
+        assert!(
+            s.particles.liquid_m3.iter().all(|&l| l >= 0.0),
+            "negative liquid on a particle"
+        );
+    }
+    let s = sim.snapshot();
+    let events = sim.cohesion_events;
+    let on_b: f64 = s
+        .particles
+        .liquid_m3
+        .iter()
+        .zip(&s.particles.species)
+        .filter(|(_, sp)| sp.0 == 1)
+        .map(|(l, _)| l)
+        .sum();
+    println!(
+        "B4: {} particles, {} bridges formed, {} broken, {} standing, liquid drift {worst:e}; the 50° species holds {:.3} of the particles' liquid",
+        s.particles.len(),
+        events.bridges_formed,
+        events.bridges_ruptured,
+        s.cohesion.pairs.len(),
+        on_b / s.particles.liquid_m3.iter().sum::<f64>()
+    );
+    assert!(
+        events.bridges_formed > 1500 && events.bridges_ruptured > 500,
+        "{events:?}"
+    );
+    assert!(worst < 1e-10, "liquid drifted by {worst:e} of the total");
+}
+
+fn final_state(dir: &Path) -> SimState {
+    let series = CheckpointSeries::new(dir, 2);
+    series
+        .latest_valid()
+        .expect("lists")
+        .expect("a checkpoint exists")
+        .state
+}
+
+/// A wet run stopped and resumed in a fresh process (on another thread count) ends bit-identical to an
+/// uninterrupted one, bridges, liquid and all; 1 and 2 threads agree to the bit.
+#[test]
+fn a_wet_drum_restarts_bit_identically_on_any_thread_count() {
+    let tmp = tempfile::tempdir().expect("temp dir");
+    let dir = tmp.path();
+    let short = WET_DRUM.replace("end_time_s: 0.08", "end_time_s: 0.04");
+    std::fs::write(dir.join("wet.yaml"), &short).expect("write scenario");
+    let run = |args: &[&str]| {
+        let out = granflow(args, dir);
+        assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    };
+    run(&["simulate", "wet.yaml", "--out", "whole", "--quiet"]);
+    run(&[
+        "simulate",
+        "wet.yaml",
+        "--out",
+        "split",
+        "--max-steps",
+        "2000",
+        "--threads",
+        "2",
+        "--quiet",
+    ]);
+    let middle = final_state(&dir.join("split"));
+    assert!(middle.cohesion.pairs.len() > 50, "bridges cross the restart");
+    run(&["simulate", "wet.yaml", "--out", "split", "--threads", "1", "--quiet"]);
+    let whole = final_state(&dir.join("whole"));
+    let split = final_state(&dir.join("split"));
+    assert_eq!(whole.step, 4000);
+    if let Some(diff) = first_difference(&whole, &split) {
+        panic!("restarted wet run differs from the uninterrupted one: {diff}");
+    }
+    let b = built(&short);
+    let mut two = simulation(&b, 2);
+    two.run_steps(4000).expect("stable");
+    if let Some(diff) = first_difference(&whole, &two.snapshot()) {
+        panic!("2 threads differ from 1: {diff}");
+    }
+}
+
+/// Two beads in one layer, no gravity.
+fn pair(cohesion: &str, gap_m: f64, extra_species: &str) -> String {
+    format!(
+        r#"
+name: pair
+domain: {{ lo_m: [-0.01, -0.01, -0.01], hi_m: [0.01, 0.01, 0.01] }}
+gravity: {{ vector_m_per_s2: [0.0, 0.0, 0.0] }}
+species:
+  - {{ name: s, radius_m: 0.001, density_kg_per_m3: 2500.0, youngs_modulus_pa: 1.0e7, poisson_ratio: 0.3, friction_coefficient: 0.3{extra_species} }}
+contact: {{ normal: {{ hertz: {{ restitution: 0.8 }} }}, tangential: mindlin }}
+cohesion: {cohesion}
+fill:
+  - lattice: {{ species: s, spacing_m: {spacing}, lo_m: [-0.0015, -0.0005, -0.0005], hi_m: [0.0025, 0.0005, 0.0005], origin_m: [-0.001, 0.0, 0.0] }}
+time: {{ dt_s: 1.0e-6, end_time_s: 1.0 }}
+"#,
+        spacing = 0.002 + gap_m
+    )
+}
+
+fn two_beads(yaml: &str) -> granflow::engine::Simulation {
+    let b = built(yaml);
+    assert_eq!(b.particles.len(), 2, "the fill places two beads");
+    simulation(&b, 1)
+}
+
+/// The Hamaker force on two beads at rest is A R*/(6 H²) (seed 001 eq 6.34), pulling them together, and is
+/// left out beyond the outer cutoff.
+#[test]
+fn hamaker_pulls_two_beads_with_the_printed_force() {
+    for (gap, inside) in [(2.0e-6, true), (5.0e-5, false)] {
+        let sim = two_beads(&pair(
+            "{ hamaker: { constant_j: 1.0e-17, inner_cutoff_m: 4.0e-10, outer_cutoff_m: 2.0e-5 } }",
+            gap,
+            "",
+        ));
+        let expected = if inside {
+            1.0e-17 * 0.0005 / (6.0 * gap * gap)
+        } else {
+            0.0
+        };
+        let f = sim.particles.force_n[0];
+        assert!(
+            (f.x - expected).abs() <= 1e-9 * expected,
+            "gap {gap}: {f:?} vs {expected}"
+        );
+        assert_eq!(sim.particles.force_n[1].x, -f.x);
+    }
+}
+
+/// Two wet beads brought into contact hold together: a bridge forms on contact, and once the viscous liquid has
+/// damped the motion they rest at the overlap where the Hertz force balances Mikami's capillary force at contact.
+#[test]
+fn a_liquid_bridge_holds_two_beads_at_the_hertz_capillary_balance() {
+    let mut sim = two_beads(&pair(
+        "{ liquid_bridge: { surface_tension_n_per_m: 0.072, viscosity_pa_s: 0.01 } }",
+        1.0e-6,
+        ", liquid_content: 0.02",
+    ));
+    sim.particles.velocity_m_per_s[0].x = 0.005;
+    sim.particles.velocity_m_per_s[1].x = -0.005;
+    sim.run_steps(200_000).expect("stable");
+    let s = sim.snapshot();
+    assert_eq!(s.cohesion.pairs.len(), 1, "one bridge");
+    let volume = s.cohesion.pairs[0].2.bridge_volume_m3;
+    // Each bead gave the liquid on its cap facing the other: (L/2)(1 − √(1 − 1/4)) of L = 0.02 R³.
+    let expected_volume = 2.0 * 0.5 * 0.02e-9 * (1.0 - 0.75f64.sqrt());
+    assert!(
+        (volume / expected_volume - 1.0).abs() < 1e-12,
+        "{volume} vs {expected_volume}"
+    );
+    let d = (s.particles.position_m[0] - s.particles.position_m[1]).norm();
+    let overlap = 0.002 - d;
+    let r_star = 0.0005;
+    let e_star = 1.0e7 / (2.0 * (1.0 - 0.09));
+    let capillary = mikami_force_n(r_star, volume, 0.0, 0.0, 0.072);
+    let expected = (capillary / (4.0 / 3.0 * e_star * r_star.sqrt())).powf(2.0 / 3.0);
+    println!("bridge: V = {volume:e} m³, overlap {overlap:e} m (Hertz–capillary balance {expected:e} m)");
+    assert!((overlap / expected - 1.0).abs() < 0.01, "{overlap} vs {expected}");
+    assert!(s.particles.velocity_m_per_s[0].norm() < 1e-6);
+    // The force scale: about 2πRγ cos θ at contact for R = 2R*.
+    assert!(
+        (capillary / (2.0 * PI * 0.001 * 0.072) - 0.9).abs() < 0.1,
+        "{capillary}"
+    );
+}
+
+/// Square well as crossing impulses (seed 001 §6.2.4.2): a head-on pair approaching at relative speed a₀ gains
+/// 2D/μ of squared speed entering the well, collides with restitution e and escapes with √(e²(a₀² + 2D/μ) − 2D/μ)
+/// if that is real; otherwise it is captured and stays in the well.
+#[test]
+fn square_well_pairs_escape_or_are_captured_as_the_energy_balance_says() {
+    let mass = 2500.0 * 4.0 / 3.0 * PI * 1e-9;
+    let mu = mass / 2.0;
+    let energy = 0.01; // 2D/μ, m²/s²
+    let depth = energy * mu / 2.0;
+    let e: f64 = 0.8;
+    for approach in [0.1, 0.05] {
+        let mut sim = two_beads(&pair(
+            &format!("{{ square_well: {{ depth_j: {depth:e}, outer_to_inner_radius_ratio: 1.01 }} }}"),
+            5.0e-4,
+            "",
+        ));
+        sim.particles.velocity_m_per_s[0].x = 0.5 * approach;
+        sim.particles.velocity_m_per_s[1].x = -0.5 * approach;
+        sim.run_steps(20_000).expect("stable");
+        let s = sim.snapshot();
+        let separation = (s.particles.position_m[1] - s.particles.position_m[0]).x;
+        let speed = s.particles.velocity_m_per_s[1].x - s.particles.velocity_m_per_s[0].x;
+        let left = e * e * (approach * approach + energy) - energy;
+        println!(
+            "square well, a0 = {approach} m/s: separation {separation:e} m, separating at {speed:e} m/s, in well: {}",
+            s.cohesion.pairs.len()
+        );
+        if left > 0.0 {
+            let expected = left.sqrt();
+            assert!(separation > 0.00202, "escaped");
+            assert!((speed / expected - 1.0).abs() < 0.03, "{speed} vs {expected}");
+            assert!(s.cohesion.pairs.is_empty());
+        } else {
+            assert_eq!(s.cohesion.pairs.len(), 1, "captured");
+            assert!(s.cohesion.pairs[0].2.in_well);
+            assert!(separation < 0.002 * 1.01 + 1e-6, "still in the well: {separation}");
+        }
+    }
+}
