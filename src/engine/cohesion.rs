@@ -16,7 +16,7 @@
 use super::Vec3;
 use super::contacts::WallId;
 use super::models::capillary::{
-    bridge_volume_on_contact_m3, lian_rupture_gap_m, mikami_force_n, viscous_normal_force_n,
+    MikamiBridge, bridge_volume_on_contact_m3, lian_rupture_gap_m, viscous_normal_force_n,
     viscous_tangential_coefficient_n_s_per_m,
 };
 use super::models::cohesion_law::{CohesionModel, square_well_crossing};
@@ -280,6 +280,26 @@ impl CohesionStore {
 pub struct AlignedCohesion {
     pub pair: Vec<CohesionState>,
     pub wall: Vec<CohesionState>,
+    /// Per pair slot: the Mikami constants and rupture gap of its bridge, for the volume they were computed for
+    /// (workspace: rebuilt from the state, never checkpointed).
+    bridges: Vec<BridgeConstants>,
+}
+
+/// What a bridge's force and rupture need that stays fixed while its volume does.
+#[derive(Debug, Clone, Copy)]
+struct BridgeConstants {
+    /// The volume these were computed for (NaN: none).
+    volume_m3: f64,
+    mikami: MikamiBridge,
+    rupture_gap_m: f64,
+}
+
+impl BridgeConstants {
+    const NONE: BridgeConstants = BridgeConstants {
+        volume_m3: f64::NAN,
+        mikami: MikamiBridge::ZERO,
+        rupture_gap_m: 0.0,
+    };
 }
 
 impl AlignedCohesion {
@@ -324,6 +344,7 @@ impl AlignedCohesion {
         let mut out = AlignedCohesion {
             pair: vec![CohesionState::default(); list.partner.len()],
             wall: vec![CohesionState::default(); list.wall_partner.len()],
+            bridges: Vec::new(),
         };
         let mut orphans = 0;
         for &(i, j, s) in &store.pairs {
@@ -388,6 +409,10 @@ pub fn apply_cohesion(
     if state.wall.len() != list.wall_partner.len() {
         state.wall.resize(list.wall_partner.len(), CohesionState::default());
     }
+    if state.bridges.len() != state.pair.len() {
+        state.bridges.clear();
+        state.bridges.resize(state.pair.len(), BridgeConstants::NONE);
+    }
     for i in 0..n {
         let (xi, vi, wi, ri, mi, si) = (
             p.position_m[i],
@@ -424,17 +449,31 @@ pub fn apply_cohesion(
                         cohesion.contact_angle_rad[si.index()],
                         cohesion.contact_angle_rad[sj.index()],
                     );
-                    if slot.bridge_volume_m3 == 0.0 {
-                        if gap < 0.0 {
-                            let (from_i, from_j) = bridge_volume_on_contact_m3(p.liquid_m3[i], ri, p.liquid_m3[j], rj);
-                            if from_i + from_j > 0.0 {
-                                p.liquid_m3[i] -= from_i;
-                                p.liquid_m3[j] -= from_j;
-                                slot.bridge_volume_m3 = from_i + from_j;
-                                pass.bridges_formed += 1;
-                            }
+                    if slot.bridge_volume_m3 == 0.0 && gap < 0.0 {
+                        let (from_i, from_j) = bridge_volume_on_contact_m3(p.liquid_m3[i], ri, p.liquid_m3[j], rj);
+                        if from_i + from_j > 0.0 {
+                            p.liquid_m3[i] -= from_i;
+                            p.liquid_m3[j] -= from_j;
+                            slot.bridge_volume_m3 = from_i + from_j;
+                            pass.bridges_formed += 1;
                         }
-                    } else if gap > lian_rupture_gap_m(slot.bridge_volume_m3, ti, tj).min(cohesion.range_m) {
+                    }
+                    let constants = &mut state.bridges[k];
+                    if slot.bridge_volume_m3 > 0.0 && constants.volume_m3 != slot.bridge_volume_m3 {
+                        // CHOICE: Mikami's fit is for equal wetting; unequal angles use their mean until the
+                        // Young–Laplace table replaces it.
+                        *constants = BridgeConstants {
+                            volume_m3: slot.bridge_volume_m3,
+                            mikami: MikamiBridge::new(
+                                r_star,
+                                slot.bridge_volume_m3,
+                                0.5 * (ti + tj),
+                                b.surface_tension_n_per_m,
+                            ),
+                            rupture_gap_m: lian_rupture_gap_m(slot.bridge_volume_m3, ti, tj).min(cohesion.range_m),
+                        };
+                    }
+                    if slot.bridge_volume_m3 > 0.0 && gap > constants.rupture_gap_m {
                         let volume = slot.bridge_volume_m3;
                         let kept_by_i = cohesion.rupture_share_of_i(si, sj, volume) * volume;
                         p.liquid_m3[i] += kept_by_i;
@@ -443,16 +482,7 @@ pub fn apply_cohesion(
                         pass.bridges_ruptured += 1;
                     }
                     if slot.bridge_volume_m3 > 0.0 {
-                        // CHOICE: Mikami's fit is for equal wetting; unequal angles use their mean until the
-                        // Young–Laplace table replaces it.
-                        let capillary = mikami_force_n(
-                            r_star,
-                            slot.bridge_volume_m3,
-                            gap,
-                            0.5 * (ti + tj),
-                            b.surface_tension_n_per_m,
-                        );
-                        let mut normal_force = -capillary;
+                        let mut normal_force = -constants.mikami.force_n(gap);
                         if b.viscosity_pa_s > 0.0 {
                             normal_force +=
                                 viscous_normal_force_n(r_star, b.viscosity_pa_s, approach, gap, cohesion.min_gap_m);
