@@ -48,50 +48,56 @@ fn evaluate(
             .iter()
             .position(|h| h == &format!("metric.{name}") || h.starts_with(&format!("metric.{name} [")))
     };
-    let mut values = Vec::new();
-    match &check.value {
-        CheckValue::Metric(_) | CheckValue::Ratio(_) => {
-            let status = column("status");
-            for row in rows {
-                if status.is_some_and(|s| row[s] != Value::String("done".into())) {
-                    continue;
-                }
-                let matches = check
-                    .filter
-                    .iter()
-                    .all(|(k, v)| column(&format!("param.{k}")).is_some_and(|c| same(&row[c], v)));
-                if !matches {
-                    continue;
-                }
-                let get = |m: &str| metric(m).and_then(|c| row[c].as_f64()).unwrap_or(f64::NAN);
-                values.push(match &check.value {
-                    CheckValue::Metric(m) => get(m),
-                    CheckValue::Ratio([a, b]) => get(a) / get(b),
-                    CheckValue::Derived(_) => unreachable!(),
-                });
-            }
-        }
-        CheckValue::Derived(name) => {
-            for (group, n, value) in derived {
-                if n != name {
-                    continue;
-                }
-                let group: BTreeMap<String, Value> = serde_json::from_str(group).unwrap_or_default();
-                if check
-                    .filter
-                    .iter()
-                    .all(|(k, v)| group.get(k).is_some_and(|g| same(g, v)))
-                {
-                    values.push(value.unwrap_or(f64::NAN));
+    // The mean of the value over the jobs (or derived groups) matching `filter`, and how many there were.
+    let mean_for = |filter: &BTreeMap<String, Value>| -> (f64, usize) {
+        let mut values = Vec::new();
+        match &check.value {
+            CheckValue::Metric(_) | CheckValue::Ratio(_) => {
+                let status = column("status");
+                for row in rows {
+                    if status.is_some_and(|s| row[s] != Value::String("done".into())) {
+                        continue;
+                    }
+                    let matches = filter
+                        .iter()
+                        .all(|(k, v)| column(&format!("param.{k}")).is_some_and(|c| same(&row[c], v)));
+                    if !matches {
+                        continue;
+                    }
+                    let get = |m: &str| metric(m).and_then(|c| row[c].as_f64()).unwrap_or(f64::NAN);
+                    values.push(match &check.value {
+                        CheckValue::Metric(m) => get(m),
+                        CheckValue::Ratio([a, b]) => get(a) / get(b),
+                        CheckValue::Derived(_) => unreachable!(),
+                    });
                 }
             }
+            CheckValue::Derived(name) => {
+                for (group, n, value) in derived {
+                    if n != name {
+                        continue;
+                    }
+                    let group: BTreeMap<String, Value> = serde_json::from_str(group).unwrap_or_default();
+                    if filter.iter().all(|(k, v)| group.get(k).is_some_and(|g| same(g, v))) {
+                        values.push(value.unwrap_or(f64::NAN));
+                    }
+                }
+            }
         }
-    }
-    let ours = if values.is_empty() {
-        f64::NAN
-    } else {
-        values.iter().sum::<f64>() / values.len() as f64
+        let mean = if values.is_empty() {
+            f64::NAN
+        } else {
+            values.iter().sum::<f64>() / values.len() as f64
+        };
+        (mean, values.len())
     };
+    let (mut ours, samples) = mean_for(&check.filter);
+    if !check.relative_to.is_empty() {
+        // The same value with the reference parameters in place of (or beside) the filter's.
+        let mut reference = check.filter.clone();
+        reference.extend(check.relative_to.clone());
+        ours /= mean_for(&reference).0;
+    }
     let (pass, criterion) = match (check.tolerance_rel, check.range) {
         (Some(t), _) => (
             (ours / check.expected - 1.0).abs() <= t,
@@ -105,7 +111,7 @@ fn evaluate(
         ours,
         expected: check.expected,
         criterion,
-        samples: values.len(),
+        samples,
         pass: pass && ours.is_finite(),
     }
 }
@@ -259,4 +265,33 @@ pub fn report(dir: &Path) -> Result<(String, bool), Error> {
         let _ = writeln!(md, "verdict: fail ({})", failed.join("; "));
     }
     Ok((md, pass))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A check with `relative_to` divides the matching jobs' mean by the reference jobs' mean (the other filter
+    /// entries kept).
+    #[test]
+    fn relative_checks_divide_by_the_reference_jobs() {
+        let header: Vec<String> = ["status", "param.gamma", "param.u", "metric.k [1/s]"]
+            .iter()
+            .map(|s| s.to_string())
+            .collect();
+        let row = |g: f64, u: f64, k: f64| vec![Value::from("done"), Value::from(g), Value::from(u), Value::from(k)];
+        let rows = vec![
+            row(0.0, 2.0, 4.0),
+            row(0.08, 2.0, 1.0),
+            row(0.0, 2.8, 8.0),
+            row(0.08, 2.8, 3.0),
+        ];
+        let de = serde_norway::Deserializer::from_str(
+            "{ name: wet over dry, value: { metric: k }, where: { gamma: 0.08, u: 2.8 }, relative_to: { gamma: 0.0 }, expected: 0.5, range: [0.0, 1.0] }",
+        );
+        let check: CheckSpec = serde_norway::with::singleton_map_recursive::deserialize(de).expect("parses");
+        let result = evaluate(&check, &header, &rows, &[]);
+        assert_eq!(result.ours, 3.0 / 8.0);
+        assert!(result.pass);
+    }
 }

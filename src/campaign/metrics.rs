@@ -241,6 +241,17 @@ pub fn check(spec: &CampaignSpec) -> Result<(), (String, String)> {
             ),
         ));
     }
+    if let Some(t) = spec.analysis.mixing_fit_from_s
+        && !(t.is_finite() && t >= 0.0 && t < spec.base.time.end_time_s)
+    {
+        return Err((
+            "analysis.mixing_fit_from_s".into(),
+            format!(
+                "expected 0 <= value < the end time ({} s), got {t}",
+                spec.base.time.end_time_s
+            ),
+        ));
+    }
     if spec.analysis.mixing_neighbours == 0 {
         return Err(("analysis.mixing_neighbours".into(), "expected at least 1".into()));
     }

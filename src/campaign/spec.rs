@@ -112,6 +112,10 @@ pub struct AnalysisSpec {
     /// Ca_g11 = 2.12 and Ca_g22 = 1.93 (air at 1.8 m/s, γ = 0.030 N/m from its Bo_g11) within 1 %.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub capillary_number_porosity: Option<f64>,
+    /// The mixing rate constant fits IS(t) from this time on, s (default: from the start); for runs that settle or
+    /// start a gas before mixing begins.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub mixing_fit_from_s: Option<f64>,
 }
 
 fn default_neighbours() -> usize {
@@ -126,6 +130,7 @@ impl Default for AnalysisSpec {
             mixing_every_steps: None,
             average_from_s: None,
             capillary_number_porosity: None,
+            mixing_fit_from_s: None,
         }
     }
 }

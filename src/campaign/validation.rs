@@ -28,6 +28,10 @@ pub struct CheckSpec {
     /// with a relative tolerance of 1e-9.
     #[serde(default, rename = "where")]
     pub filter: std::collections::BTreeMap<String, serde_json::Value>,
+    /// Divide by the same value for the jobs (or groups) matching `where` with these parameter values put in: e.g.
+    /// a wet run's u_mf over the dry run's. Empty: no division.
+    #[serde(default, skip_serializing_if = "std::collections::BTreeMap::is_empty")]
+    pub relative_to: std::collections::BTreeMap<String, serde_json::Value>,
     /// The source's number.
     pub expected: f64,
     /// Pass when |ours/expected − 1| ≤ this ...

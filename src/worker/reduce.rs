@@ -150,7 +150,8 @@ pub fn metrics(job: &JobSpec, built: &BuiltScenario, sim: &Simulation, series: &
         let t = series.column("time_s")?;
         let is = series.column("intensity_of_segregation")?;
         let lacey = series.column("lacey_index")?;
-        let rows: Vec<usize> = (0..t.len()).filter(|&k| is[k].is_finite()).collect();
+        let from_s = job.analysis.mixing_fit_from_s.unwrap_or(f64::NEG_INFINITY);
+        let rows: Vec<usize> = (0..t.len()).filter(|&k| is[k].is_finite() && t[k] >= from_s).collect();
         Some((
             rows.iter().map(|&k| t[k]).collect(),
             rows.iter().map(|&k| is[k]).collect(),
