@@ -149,6 +149,12 @@ const CASES: &[(&str, &str, &str, &[&str])] = &[
         &["cohesion.square_well.outer_to_inner_radius_ratio", "> 1"],
     ),
     (
+        "spray with no liquid",
+        "time: {",
+        "cohesion: { liquid_bridge: { surface_tension_n_per_m: 0.072, spray: { max_liquid_content: 0.0 } } }\ntime: {",
+        &["cohesion.liquid_bridge.spray.max_liquid_content", "> 0"],
+    ),
+    (
         "unknown cohesion model",
         "time: {",
         "cohesion: { capillary: { surface_tension_n_per_m: 0.072 } }\ntime: {",

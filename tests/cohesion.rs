@@ -13,7 +13,8 @@ use granflow::engine::models::capillary::mikami_force_n;
 use granflow::engine::state::{SimState, first_difference};
 
 /// A wet rotating drum: two species of 3 mm beads (contact angles 20° and 50°) carrying V̂ = 0.01 of water each,
-/// the lattice collapsing into the drum's bed while it turns.
+/// the lattice collapsing into the drum's bed while it turns, the bed's surface sprayed up to V̂ = 0.02 every 50
+/// steps.
 const WET_DRUM: &str = r#"
 name: wet-drum
 domain: { lo_m: [-0.041, -0.041, 0.0], hi_m: [0.041, 0.041, 0.012], periodic: [false, false, true] }
@@ -22,7 +23,7 @@ species:
   - { name: a, radius_m: 0.0015, density_kg_per_m3: 2500.0, youngs_modulus_pa: 5.0e7, poisson_ratio: 0.3, friction_coefficient: 0.4, contact_angle_deg: 20.0, liquid_content: 0.01 }
   - { name: b, radius_m: 0.0015, density_kg_per_m3: 2500.0, youngs_modulus_pa: 5.0e7, poisson_ratio: 0.3, friction_coefficient: 0.4, contact_angle_deg: 50.0, liquid_content: 0.01 }
 contact: { normal: { hertz: { restitution: 0.6 } }, tangential: mindlin }
-cohesion: { liquid_bridge: { surface_tension_n_per_m: 0.072, viscosity_pa_s: 0.001 } }
+cohesion: { liquid_bridge: { surface_tension_n_per_m: 0.072, viscosity_pa_s: 0.001, spray: { max_liquid_content: 0.02, every_steps: 50 } } }
 walls:
   - drum:
       name: drum
@@ -41,13 +42,15 @@ output: { checkpoint_every_steps: 2000, keep_checkpoints: 2, series_every_steps:
 seed: 5
 "#;
 
+/// Liquid on the particles and in bridges, less what the spray brought.
 fn liquid(state: &SimState) -> f64 {
     state.particles.liquid_m3.iter().sum::<f64>() + state.cohesion.bridge_liquid_m3()
+        - state.particles.sprayed_m3.iter().sum::<f64>()
 }
 
-/// VALIDATION B4 (bridges; spray and evaporation are not built yet): the particles' liquid plus the bridges'
-/// volume stays what the particles started with, to 1e-10 relative, while thousands of bridges form and break
-/// between particles of unequal wettability.
+/// VALIDATION B4 (bridges and spray; evaporation is not built yet): the particles' liquid plus the bridges' volume
+/// stays what the particles started with plus what was sprayed, to 1e-10 relative, while thousands of bridges form
+/// and break between particles of unequal wettability and the surface is sprayed.
 #[test]
 fn b4_liquid_is_conserved_while_bridges_form_and_break() {
     let b = built(WET_DRUM);
@@ -66,6 +69,18 @@ fn b4_liquid_is_conserved_while_bridges_form_and_break() {
     }
     let s = sim.snapshot();
     let events = sim.cohesion_events;
+    let sprayed: f64 = s.particles.sprayed_m3.iter().sum();
+    let wetted = s.particles.sprayed_m3.iter().filter(|&&v| v > 0.0).count();
+    println!(
+        "spray: {sprayed:e} m³ ({:.2} of the start) onto {wetted} particles, CV_m {:.2}",
+        sprayed / start,
+        granflow::engine::spray::coating_variability(&s.particles.sprayed_m3)
+    );
+    assert!(
+        sprayed > 0.1 * start && wetted > 20 && wetted < s.particles.len() / 2,
+        "{wetted} sprayed"
+    );
+    assert!((sim.sprayed_m3 / sprayed - 1.0).abs() < 1e-12);
     let on_b: f64 = s
         .particles
         .liquid_m3

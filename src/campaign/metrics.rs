@@ -2,7 +2,7 @@
 
 use super::JobSpec;
 use super::spec::CampaignSpec;
-use crate::engine::models::cohesion_law::CohesionModel;
+use crate::engine::models::cohesion_law::{CohesionModel, LiquidBridge};
 
 /// A metric a worker can reduce from its job.
 #[derive(Debug, Clone, Copy)]
@@ -192,6 +192,13 @@ pub const METRICS: &[MetricInfo] = &[
         needs_gas: true,
     },
     MetricInfo {
+        name: "coating_variability",
+        unit: "1",
+        description: "CV_m = σ/μ of the liquid each particle received from the spray (seed 000 eq. 6.45)",
+        needs_mixing: false,
+        needs_gas: false,
+    },
+    MetricInfo {
         name: "probe_pressure_drop_mean_pa",
         unit: "Pa",
         description: "time-averaged pressure drop from the inlet to gas.pressure_probe_height_m",
@@ -316,6 +323,18 @@ pub fn check_job(job: &JobSpec) -> Result<(), (String, String)> {
                 ),
             ));
         }
+    }
+    let sprayed = matches!(
+        job.scenario.cohesion,
+        Some(CohesionModel::LiquidBridge(LiquidBridge { spray: Some(_), .. }))
+    );
+    if let Some(k) = job.metrics.iter().position(|m| m == "coating_variability")
+        && !sprayed
+    {
+        return Err((
+            format!("metrics[{k}]"),
+            "`coating_variability` needs a spray (`cohesion: { liquid_bridge: { spray: ... } }`)".into(),
+        ));
     }
     if let Some(eps) = job.analysis.capillary_number_porosity
         && !(eps.is_finite() && eps > 0.0 && eps <= 1.0)

@@ -224,6 +224,7 @@ datasets! {
     gas_last_converged: u8 => "gas/last_step/converged", Rows::GasScalar, 1, "1";
 
     liquid_m3: f64 => "particles/liquid_m3", Rows::Particles, 1, "m3";
+    sprayed_m3: f64 => "particles/sprayed_m3", Rows::Particles, 1, "m3";
     cohesion_pair_i: u32 => "cohesion/pairs/i", Rows::CohesionPairs, 1, "1";
     cohesion_pair_j: u32 => "cohesion/pairs/j", Rows::CohesionPairs, 1, "1";
     cohesion_pair_bridge_volume_m3: f64 => "cohesion/pairs/bridge_volume_m3", Rows::CohesionPairs, 1, "m3";
@@ -395,6 +396,7 @@ impl Arrays {
             gas_last_converged: gas.map(|g| u8::from(g.last.converged)).into_iter().collect(),
 
             liquid_m3: p.liquid_m3.clone(),
+            sprayed_m3: p.sprayed_m3.clone(),
             cohesion_pair_i: state.cohesion.pairs.iter().map(|(i, _, _)| i.0).collect(),
             cohesion_pair_j: state.cohesion.pairs.iter().map(|(_, j, _)| j.0).collect(),
             cohesion_pair_bridge_volume_m3: state
@@ -508,6 +510,7 @@ impl Arrays {
             force_n: unflatten(&self.force_n),
             torque_n_m: unflatten(&self.torque_n_m),
             liquid_m3: self.liquid_m3,
+            sprayed_m3: self.sprayed_m3,
         };
         let state_at = |volume: &[f64], in_well: &[u8], k: usize| CohesionState {
             bridge_volume_m3: volume[k],

@@ -466,6 +466,7 @@ mod tests {
             p.torque_n_m
                 .push(v(-1.0e-9 * f, f64::from_bits(0x7ff8_0000_dead_beef), f64::MAX / f));
             p.liquid_m3.push(1.0e-12 / f);
+            p.sprayed_m3.push(3.0e-13 * f);
         }
         p.position_m[2].x = DISTINCTIVE;
         let contacts = ContactStore {
@@ -1111,6 +1112,7 @@ mod tests {
         );
         ds(&mut b, "gas/last_step/converged", &[1], &[u8::from(gas.last.converged)]);
         ds(&mut b, "particles/liquid_m3", &[n], &f(p.liquid_m3.iter().copied()));
+        ds(&mut b, "particles/sprayed_m3", &[n], &f(p.sprayed_m3.iter().copied()));
         type CohesionTable = (&'static str, Vec<u8>, Vec<u8>, Vec<CohesionState>);
         let cohesion: [CohesionTable; 2] = [
             (

@@ -107,6 +107,29 @@ impl Cohesion {
                     largest_liquid = largest_liquid.max(s.liquid_content * s.radius_m.powi(3));
                     largest_angle = largest_angle.max(s.contact_angle_deg.to_radians());
                 }
+                if let Some(spray) = b.spray {
+                    if !(spray.max_liquid_content.is_finite() && spray.max_liquid_content > 0.0) {
+                        return Err((
+                            "cohesion.liquid_bridge.spray.max_liquid_content".into(),
+                            format!("expected a finite value > 0, got {}", spray.max_liquid_content),
+                        ));
+                    }
+                    if spray.every_steps == 0 {
+                        return Err((
+                            "cohesion.liquid_bridge.spray.every_steps".into(),
+                            "expected at least 1".into(),
+                        ));
+                    }
+                    if !(spray.start_s.is_finite() && spray.start_s >= 0.0) {
+                        return Err((
+                            "cohesion.liquid_bridge.spray.start_s".into(),
+                            format!("expected a finite value >= 0, got {}", spray.start_s),
+                        ));
+                    }
+                    for s in &species.species {
+                        largest_liquid = largest_liquid.max(spray.max_liquid_content * s.radius_m.powi(3));
+                    }
+                }
                 cohesion.range_m = lian_rupture_gap_m(
                     2.0 * BRIDGE_VOLUME_ALLOWANCE * largest_liquid,
                     largest_angle,

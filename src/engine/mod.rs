@@ -13,6 +13,7 @@ pub mod models;
 pub mod neighbor;
 pub mod particles;
 pub mod simulation;
+pub mod spray;
 pub mod state;
 pub mod team;
 

@@ -115,6 +115,8 @@ pub struct Particles {
     pub torque_n_m: Vec<Vec3>,
     /// Liquid carried on the particle's surface (not in bridges), m³.
     pub liquid_m3: Vec<f64>,
+    /// Liquid the particle has received from the spray since the start, m³ (for the coating variability CV_m).
+    pub sprayed_m3: Vec<f64>,
 }
 
 impl Particles {
@@ -141,6 +143,7 @@ impl Particles {
         self.force_n.push(Vec3::zeros());
         self.torque_n_m.push(Vec3::zeros());
         self.liquid_m3.push(species.liquid_content * radius_m.powi(3));
+        self.sprayed_m3.push(0.0);
         id
     }
 
@@ -173,7 +176,8 @@ impl Particles {
             + (self.radius_m.capacity()
                 + self.mass_kg.capacity()
                 + self.inertia_kg_m2.capacity()
-                + self.liquid_m3.capacity())
+                + self.liquid_m3.capacity()
+                + self.sprayed_m3.capacity())
                 * 8
             + (self.position_m.capacity()
                 + self.velocity_m_per_s.capacity()

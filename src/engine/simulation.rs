@@ -14,9 +14,11 @@ use super::forces::{ForcePass, HalfKick, PairBuffers, RangePlan, compute_contact
 use super::gas::coupled::GasCoupling;
 use super::geometry::{Domain, Gravity, Wall};
 use super::integrate::{InverseInertia, find_lost, kick_drift};
+use super::models::cohesion_law::{CohesionModel, LiquidBridge};
 use super::models::{ContactLaw, PairTable};
 use super::neighbor::{NeighborList, Reach};
 use super::particles::{ParticleId, Particles, SpeciesTable};
+use super::spray::spray_surface;
 use super::state::{RngState, SimState};
 use super::team::Team;
 use super::{NumericalError, Vec3};
@@ -86,6 +88,8 @@ pub struct Simulation {
     cohesion: AlignedCohesion,
     /// Events of the cohesion passes since the start of this process.
     pub cohesion_events: CohesionPass,
+    /// Liquid sprayed since the start of this process, m³ (the state keeps it per particle).
+    pub sprayed_m3: f64,
     buffers: PairBuffers,
     inverse: InverseInertia,
     /// Particle ranges of the parallel force pass, rebalanced at every neighbour-list build.
@@ -131,6 +135,7 @@ impl Simulation {
             history: AlignedHistory::default(),
             cohesion: AlignedCohesion::default(),
             cohesion_events: CohesionPass::default(),
+            sprayed_m3: 0.0,
             buffers: PairBuffers::default(),
             inverse,
             ranges: RangePlan::default(),
@@ -165,6 +170,7 @@ impl Simulation {
             history: AlignedHistory::default(),
             cohesion: AlignedCohesion::default(),
             cohesion_events: CohesionPass::default(),
+            sprayed_m3: 0.0,
             buffers: PairBuffers::default(),
             inverse,
             ranges: RangePlan::default(),
@@ -477,6 +483,14 @@ impl Simulation {
             return;
         };
         let t = Instant::now();
+        if let CohesionModel::LiquidBridge(LiquidBridge { spray: Some(spray), .. }) = cohesion.model
+            && dt > 0.0
+            && self.time_s >= spray.start_s
+            && self.step.is_multiple_of(spray.every_steps)
+        {
+            let g = self.config.gravity.at(self.time_s);
+            self.sprayed_m3 += spray_surface(&mut self.particles, &g, spray.max_liquid_content);
+        }
         if !self.accumulators_zeroed {
             self.particles.force_n.iter_mut().for_each(|f| *f = Vec3::zeros());
             self.particles.torque_n_m.iter_mut().for_each(|t| *t = Vec3::zeros());

@@ -237,6 +237,7 @@ pub fn first_difference(a: &SimState, b: &SimState) -> Option<String> {
                 })
         })
         .or_else(|| scalars("particles.liquid_m3", &p.liquid_m3, &q.liquid_m3))
+        .or_else(|| scalars("particles.sprayed_m3", &p.sprayed_m3, &q.sprayed_m3))
         .or_else(|| cohesion_difference(&a.cohesion, &b.cohesion))
 }
 

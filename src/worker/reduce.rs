@@ -195,6 +195,7 @@ pub fn metrics(job: &JobSpec, built: &BuiltScenario, sim: &Simulation, series: &
                 window(series, "probe_pressure_drop_pa", average_from_s).map_or(f64::NAN, |w| mean(&w))
             }
             wet if wet.starts_with("granular_") || wet == "wet_phase_mixed" => wet_number(wet, job, built, sim),
+            "coating_variability" => crate::engine::spray::coating_variability(&sim.particles.sprayed_m3),
             other => return Err(Error::External(format!("metric `{other}` has no reducer"))),
         };
         out.push(Metric {

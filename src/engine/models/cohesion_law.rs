@@ -33,6 +33,28 @@ pub struct LiquidBridge {
     /// smallest particle radius.
     #[serde(default)]
     pub min_gap_m: Option<f64>,
+    /// Liquid sprayed onto the bed's free surface (seed 000 §6.3.2); absent: none.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub spray: Option<Spray>,
+}
+
+/// Spray from above (seed 000 §6.3.2): at every spray step the particles on the bed's free surface get their liquid
+/// raised to `max_liquid_content`.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize, schemars::JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct Spray {
+    /// The liquid a sprayed particle is brought up to, as V̂ = V/R³ (seed 000: 0.02).
+    pub max_liquid_content: f64,
+    /// Spray every this many steps (seed 000: every step; default 1).
+    #[serde(default = "one")]
+    pub every_steps: u64,
+    /// Spraying starts at this time, s (default 0).
+    #[serde(default)]
+    pub start_s: f64,
+}
+
+fn one() -> u64 {
+    1
 }
 
 /// Hamaker parameters; the force acts between surfaces closer than `outer_cutoff_m`.
