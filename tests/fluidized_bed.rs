@@ -80,6 +80,12 @@ fn a_bed_under_an_inflow_ramp_restarts_bit_identically() {
     restart_is_exact("  inflow_ramp: { start_s: 0.005, duration_s: 0.02 }");
 }
 
+#[test]
+fn a_bed_under_stepped_inflow_levels_restarts_bit_identically() {
+    // Levels of 4 ms from 5 ms: the stop at 15 ms falls in the third level (the gas off).
+    restart_is_exact("  inflow_levels: { start_s: 0.005, hold_s: 0.004, factors: [1.0, 0.5, 0.0, 0.5, 1.0] }");
+}
+
 fn restart_is_exact(extra: &str) {
     let tmp = tempfile::tempdir().expect("temp dir");
     let dir = tmp.path();
@@ -161,6 +167,16 @@ fn bad_gas_input_is_rejected_with_its_key_before_anything_is_written() {
             "dem_steps_per_gas_step: 7",
             "dem_steps_per_gas_step: 7\n  inflow_ramp: { start_s: 0.0, duration_s: .nan }",
             "gas.inflow_ramp.duration_s",
+        ),
+        (
+            "dem_steps_per_gas_step: 7",
+            "dem_steps_per_gas_step: 7\n  inflow_levels: { hold_s: 0.0, factors: [1.0] }",
+            "gas.inflow_levels.hold_s",
+        ),
+        (
+            "dem_steps_per_gas_step: 7",
+            "dem_steps_per_gas_step: 7\n  inflow_levels: { hold_s: 0.1, factors: [1.0, -0.5] }",
+            "gas.inflow_levels.factors[1]",
         ),
     ];
     let tmp = tempfile::tempdir().expect("temp dir");

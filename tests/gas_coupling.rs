@@ -56,6 +56,7 @@ time: {{ dt_s: 1.0e-4, end_time_s: 2.0 }}
         pressure_solver: Default::default(),
         inlet_faces: Vec::new(),
         inflow_ramp: None,
+        inflow_levels: None,
         blocked: Vec::new(),
     };
     let mass = dem.particles.mass_kg[0];

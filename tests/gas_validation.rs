@@ -20,6 +20,7 @@ fn config(grid: Grid, density: f64, viscosity: f64, convection: Convection) -> G
         pressure_solver: Default::default(),
         inlet_faces: Vec::new(),
         inflow_ramp: None,
+        inflow_levels: None,
         blocked: Vec::new(),
     }
 }

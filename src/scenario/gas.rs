@@ -14,7 +14,7 @@ use crate::engine::gas::coupling::PorosityMethod;
 use crate::engine::gas::fluid_forces::{DragCoupling, DragVelocities};
 use crate::engine::gas::grid::side;
 use crate::engine::gas::linsolve::PressureSolver;
-use crate::engine::gas::simple::{InflowRamp, InletFace};
+use crate::engine::gas::simple::{InflowLevels, InflowRamp, InletFace};
 use crate::engine::gas::{Boundary, Convection, GasConfig, Grid};
 use crate::engine::models::drag::DragLaw;
 
@@ -62,6 +62,10 @@ pub struct GasSpec {
     /// particles settle before the gas starts, so that all runs of a velocity sweep start from one packing.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub inflow_ramp: Option<InflowRamp>,
+    /// Inflow held at a sequence of levels, `hold_s` each from `start_s` (seed 001's defluidization/fluidization
+    /// cycle); multiplies the ramp.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub inflow_levels: Option<InflowLevels>,
     /// Height above the inlet where the pressure-drop probe sits (seed 002 Fig. 3: 20 cm). The series always has
     /// the whole-column drop too.
     #[serde(default)]
@@ -392,6 +396,32 @@ pub fn build_gas(
             ));
         }
     }
+    if let Some(levels) = &spec.inflow_levels {
+        if !levels.start_s.is_finite() || levels.start_s < 0.0 {
+            return Err(fail(
+                "gas.inflow_levels.start_s".into(),
+                format!("expected a time >= 0 s, got {}", levels.start_s),
+            ));
+        }
+        if !levels.hold_s.is_finite() || levels.hold_s <= 0.0 {
+            return Err(fail(
+                "gas.inflow_levels.hold_s".into(),
+                format!("expected a duration > 0 s, got {}", levels.hold_s),
+            ));
+        }
+        if levels.factors.is_empty() {
+            return Err(fail(
+                "gas.inflow_levels.factors".into(),
+                "expected at least one level".into(),
+            ));
+        }
+        if let Some(k) = levels.factors.iter().position(|f| !f.is_finite() || *f < 0.0) {
+            return Err(fail(
+                format!("gas.inflow_levels.factors[{k}]"),
+                format!("expected a finite factor >= 0, got {}", levels.factors[k]),
+            ));
+        }
+    }
     let mut inlet_faces = Vec::new();
     for (k, jet) in spec.jets.iter().enumerate() {
         let key = |f: &str| format!("gas.jets[{k}].{f}");
@@ -499,6 +529,7 @@ pub fn build_gas(
         pressure_solver: s.pressure_solver,
         inlet_faces,
         inflow_ramp: spec.inflow_ramp,
+        inflow_levels: spec.inflow_levels.clone(),
         blocked,
     };
     config.grid.check().map_err(|m| fail("gas.cells".into(), m))?;

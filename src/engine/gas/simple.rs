@@ -55,6 +55,8 @@ pub struct GasConfig {
     /// Inflow switched on gradually: every inlet side and inlet face is multiplied by its factor at the step's end
     /// time. `None`: full inflow from the start.
     pub inflow_ramp: Option<InflowRamp>,
+    /// Inflow changed in steps (a defluidization/fluidization cycle): multiplies the ramp's factor.
+    pub inflow_levels: Option<InflowLevels>,
     /// Cells outside the gas domain (solid: a kiln wall's outside), one flag per cell, or empty for none. Their
     /// faces are no-slip walls at rest; the design leaves room for moving them (a wall velocity per face).
     pub blocked: Vec<bool>,
@@ -92,6 +94,35 @@ impl InflowRamp {
         } else {
             (time_s - self.start_s) / self.duration_s
         }
+    }
+}
+
+/// Inflow held at a sequence of levels (seed 001 §6.4.2.1's hysteresis cycle: 0.1 s per level, down from bubbling
+/// to zero and back up): from `start_s` on, level k multiplies every inlet side and jet during
+/// [start_s + k hold_s, start_s + (k + 1) hold_s); before `start_s` the factor is 1, after the last level the last
+/// level holds.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, schemars::JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct InflowLevels {
+    #[serde(default)]
+    pub start_s: f64,
+    pub hold_s: f64,
+    /// Multipliers of the inlet velocities, one per level.
+    pub factors: Vec<f64>,
+}
+
+impl InflowLevels {
+    /// The level at `time_s` (`None` before the first).
+    pub fn level(&self, time_s: f64) -> Option<usize> {
+        if time_s < self.start_s || self.factors.is_empty() {
+            return None;
+        }
+        let k = ((time_s - self.start_s) / self.hold_s).floor() as usize;
+        Some(k.min(self.factors.len() - 1))
+    }
+
+    pub fn factor(&self, time_s: f64) -> f64 {
+        self.level(time_s).map_or(1.0, |k| self.factors[k])
     }
 }
 
@@ -245,9 +276,13 @@ impl GasSolver {
         Ok(solver)
     }
 
-    /// The inflow ramp's factor at `time_s` (1 without a ramp).
+    /// The inflow ramp's factor times the inflow level's at `time_s` (1 without either).
     pub fn inflow_factor_at(&self, time_s: f64) -> f64 {
-        self.config.inflow_ramp.map_or(1.0, |r| r.factor(time_s))
+        let ramp = self.config.inflow_ramp.map_or(1.0, |r| r.factor(time_s));
+        match &self.config.inflow_levels {
+            None => ramp,
+            Some(levels) => ramp * levels.factor(time_s),
+        }
     }
 
     /// Sets boundary-face normal velocities (walls 0, inlets their velocity) and periodic aliases.
@@ -604,7 +639,7 @@ impl GasSolver {
         let old: [Vec<f64>; 3] = self.state.velocity_m_per_s.clone();
         // Boundary values are those at the end of the step (the scheme is implicit in time). Without a ramp they
         // do not change, and the step is exactly what it was before ramps existed.
-        if self.config.inflow_ramp.is_some() {
+        if self.config.inflow_ramp.is_some() || self.config.inflow_levels.is_some() {
             self.inflow_factor = self.inflow_factor_at(self.state.time_s + dt_s);
             self.apply_boundary_velocities();
         }
@@ -794,6 +829,20 @@ fn face_index(grid: &Grid, axis: usize, f: usize) -> [usize; 3] {
 #[cfg(test)]
 mod tests {
     use super::InflowRamp;
+
+    #[test]
+    fn inflow_levels_hold_each_factor_for_its_interval() {
+        let levels = super::InflowLevels {
+            start_s: 1.0,
+            hold_s: 0.1,
+            factors: vec![1.0, 0.5, 0.0],
+        };
+        assert_eq!(levels.factor(0.5), 1.0);
+        assert_eq!(levels.level(1.0), Some(0));
+        assert_eq!(levels.factor(1.15), 0.5);
+        assert_eq!(levels.factor(1.25), 0.0);
+        assert_eq!(levels.factor(9.0), 0.0);
+    }
 
     #[test]
     fn an_inflow_ramp_is_off_then_linear_then_full() {
