@@ -114,3 +114,39 @@ fn a_fluidized_bed_campaign_stores_gas_metrics_derives_u_mf_and_reports() {
         "{report}"
     );
 }
+
+/// A gas cycle (`inflow_levels`: down from 3 m/s to 0 and back up, 0.5 ms per level) reduces to seed 001's cycle
+/// metrics; the overshoot ratio is the rising branch's largest level-mean pressure drop over W/A.
+#[test]
+fn a_gas_cycle_reduces_to_seed_001s_cycle_metrics() {
+    let tmp = tempfile::tempdir().expect("temp dir");
+    let dir = tmp.path();
+    let yaml = campaign("[249.0, 250.2]")
+        .replace(
+            "dem_steps_per_gas_step: 5",
+            "dem_steps_per_gas_step: 5\n    inflow_levels: { hold_s: 0.0005, factors: [1.0, 0.5, 0.0, 0.5, 1.0, 1.0] }",
+        )
+        .replace("values: [0.3, 1.0, 3.0]", "values: [3.0]")
+        .replace(
+            "metrics: [pressure_drop_mean_pa,",
+            "metrics: [pressure_overshoot_ratio, defluidization_velocity_m_per_s, pressure_drop_mean_pa,",
+        );
+    std::fs::write(dir.join("cycle.yaml"), yaml).unwrap();
+    let out = granflow(&["run", "cycle.yaml", "--out", "cycle", "--quiet"], dir);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let out = granflow(
+        &[
+            "query",
+            "cycle",
+            "--sql",
+            "SELECT value FROM metrics WHERE name = 'pressure_overshoot_ratio'",
+            "--format",
+            "csv",
+        ],
+        dir,
+    );
+    let text = String::from_utf8_lossy(&out.stdout);
+    let ratios: Vec<f64> = text.lines().skip(1).map(|l| l.parse().unwrap()).collect();
+    assert_eq!(ratios.len(), 2, "{text}");
+    assert!(ratios.iter().all(|r| r.is_finite() && *r > 0.0), "{ratios:?}");
+}

@@ -69,6 +69,79 @@ pub fn minimum_fluidization(points: &[SweepPoint]) -> Option<MinimumFluidization
     })
 }
 
+/// One level of a defluidization/fluidization cycle: its superficial velocity and time-averaged pressure drop.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct CycleLevel {
+    pub velocity_m_per_s: f64,
+    pub pressure_drop_mean_pa: f64,
+}
+
+/// Seed 001's three velocities of one cycle (§6.4.2.1, Fig. 6.9; notes §4): the cycle first lowers the gas
+/// (defluidization branch, down to its slowest level) and then raises it again (fluidization branch).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct CycleVelocities {
+    /// U_mf,df: the line through the falling branch's packed-bed points meets W/A.
+    pub defluidization_m_per_s: f64,
+    /// U_mf,th: the same on the rising branch.
+    pub fluidization_theoretical_m_per_s: f64,
+    /// U_mf,in: the velocity of the largest pressure drop on the rising branch, if it exceeds W/A (the overshoot
+    /// peak); NaN without an overshoot.
+    pub incipient_m_per_s: f64,
+    /// The largest pressure drop on the rising branch over W/A (above 1: an overshoot).
+    pub overshoot_ratio: f64,
+}
+
+/// The packed-bed points of a branch (CHOICE: seed 001 fits "all packed-bed points" without a rule; here those with
+/// a positive velocity and ΔP below 0.8 W/A, clear of the transition) need at least two for a line.
+const PACKED_FRACTION_OF_WEIGHT: f64 = 0.8;
+
+/// U_mf,df, U_mf,th, U_mf,in and the overshoot from the levels of one cycle in time order. The falling branch runs
+/// from the start to the first slowest level, the rising branch from there on.
+pub fn cycle_velocities(levels: &[CycleLevel], bed_weight_per_area_pa: f64) -> CycleVelocities {
+    let slowest = levels
+        .iter()
+        .enumerate()
+        .min_by(|a, b| a.1.velocity_m_per_s.total_cmp(&b.1.velocity_m_per_s))
+        .map_or(0, |(k, _)| k);
+    let (falling, rising) = levels.split_at(slowest);
+    let crossing = |branch: &[CycleLevel]| {
+        let packed: Vec<&CycleLevel> = branch
+            .iter()
+            .filter(|l| {
+                l.velocity_m_per_s > 0.0
+                    && l.pressure_drop_mean_pa.is_finite()
+                    && l.pressure_drop_mean_pa < PACKED_FRACTION_OF_WEIGHT * bed_weight_per_area_pa
+            })
+            .collect();
+        if packed.len() < 2 {
+            return f64::NAN;
+        }
+        let (a, b) = fit_line(
+            &packed.iter().map(|l| l.velocity_m_per_s).collect::<Vec<_>>(),
+            &packed.iter().map(|l| l.pressure_drop_mean_pa).collect::<Vec<_>>(),
+        );
+        if a > 0.0 {
+            (bed_weight_per_area_pa - b) / a
+        } else {
+            f64::NAN
+        }
+    };
+    let peak = rising
+        .iter()
+        .filter(|l| l.pressure_drop_mean_pa.is_finite())
+        .max_by(|a, b| a.pressure_drop_mean_pa.total_cmp(&b.pressure_drop_mean_pa));
+    let overshoot_ratio = peak.map_or(f64::NAN, |l| l.pressure_drop_mean_pa / bed_weight_per_area_pa);
+    CycleVelocities {
+        defluidization_m_per_s: crossing(falling),
+        fluidization_theoretical_m_per_s: crossing(rising),
+        incipient_m_per_s: match peak {
+            Some(l) if overshoot_ratio > 1.0 => l.velocity_m_per_s,
+            _ => f64::NAN,
+        },
+        overshoot_ratio,
+    }
+}
+
 /// Least-squares line y = a x + b.
 fn fit_line(x: &[f64], y: &[f64]) -> (f64, f64) {
     let n = x.len() as f64;
@@ -112,6 +185,38 @@ mod tests {
             "{}",
             m.from_ergun_line_m_per_s
         );
+    }
+
+    /// A cycle 2 → 0 → 2 m/s with W/A = 1000 Pa: falling packed branch ΔP = 500 u (crossing W/A at 2.0), rising
+    /// packed branch ΔP = 600 u (crossing at 1.667) and an overshoot to 1150 Pa at 1.8 m/s.
+    #[test]
+    fn a_cycle_gives_seed_001s_three_velocities() {
+        let level = |u: f64, dp: f64| CycleLevel {
+            velocity_m_per_s: u,
+            pressure_drop_mean_pa: dp,
+        };
+        let mut levels = vec![level(2.2, 1000.0), level(2.0, 990.0)];
+        for u in [1.4, 1.0, 0.6, 0.2, 0.0] {
+            levels.push(level(u, 500.0 * u));
+        }
+        for u in [0.2, 0.6, 1.0, 1.2] {
+            levels.push(level(u, 600.0 * u));
+        }
+        levels.extend([level(1.8, 1150.0), level(2.0, 1005.0), level(2.2, 998.0)]);
+        let c = cycle_velocities(&levels, 1000.0);
+        assert!((c.defluidization_m_per_s - 2.0).abs() < 1e-12, "{c:?}");
+        assert!(
+            (c.fluidization_theoretical_m_per_s - 1000.0 / 600.0).abs() < 1e-12,
+            "{c:?}"
+        );
+        assert_eq!(c.incipient_m_per_s, 1.8);
+        assert!((c.overshoot_ratio - 1.15).abs() < 1e-12);
+        // Without an overshoot there is no incipient velocity.
+        let flat: Vec<CycleLevel> = levels
+            .iter()
+            .map(|l| level(l.velocity_m_per_s, l.pressure_drop_mean_pa.min(1000.0)))
+            .collect();
+        assert!(cycle_velocities(&flat, 1000.0).incipient_m_per_s.is_nan());
     }
 
     #[test]

@@ -27,6 +27,14 @@ const WET: &[&str] = &[
     "wet_phase_mixed",
 ];
 
+/// Needs a gas with `inflow_levels`.
+const CYCLE: &[&str] = &[
+    "defluidization_velocity_m_per_s",
+    "fluidization_velocity_theoretical_m_per_s",
+    "incipient_fluidization_velocity_m_per_s",
+    "pressure_overshoot_ratio",
+];
+
 /// Needs two species (1 = the first, 2 = the second).
 const BINARY: &[&str] = &[
     "granular_bond_number_22",
@@ -192,6 +200,34 @@ pub const METRICS: &[MetricInfo] = &[
         needs_gas: true,
     },
     MetricInfo {
+        name: "defluidization_velocity_m_per_s",
+        unit: "m/s",
+        description: "U_mf,df of a gas.inflow_levels cycle: the line through the falling branch's packed-bed level means meets W/A (seed 001 §6.4.2.1)",
+        needs_mixing: false,
+        needs_gas: true,
+    },
+    MetricInfo {
+        name: "fluidization_velocity_theoretical_m_per_s",
+        unit: "m/s",
+        description: "U_mf,th: the same on the rising branch",
+        needs_mixing: false,
+        needs_gas: true,
+    },
+    MetricInfo {
+        name: "incipient_fluidization_velocity_m_per_s",
+        unit: "m/s",
+        description: "U_mf,in: the velocity of the rising branch's largest pressure drop when it exceeds W/A (the overshoot peak)",
+        needs_mixing: false,
+        needs_gas: true,
+    },
+    MetricInfo {
+        name: "pressure_overshoot_ratio",
+        unit: "1",
+        description: "the rising branch's largest level-mean pressure drop over W/A (above 1: an overshoot)",
+        needs_mixing: false,
+        needs_gas: true,
+    },
+    MetricInfo {
         name: "coating_variability",
         unit: "1",
         description: "CV_m = σ/μ of the liquid each particle received from the spray (seed 000 eq. 6.45)",
@@ -328,6 +364,18 @@ pub fn check_job(job: &JobSpec) -> Result<(), (String, String)> {
         job.scenario.cohesion,
         Some(CohesionModel::LiquidBridge(LiquidBridge { spray: Some(_), .. }))
     );
+    let cycled = job.scenario.gas.as_ref().is_some_and(|g| g.inflow_levels.is_some());
+    if let Some(k) = job.metrics.iter().position(|m| CYCLE.contains(&m.as_str()))
+        && !cycled
+    {
+        return Err((
+            format!("metrics[{k}]"),
+            format!(
+                "`{}` needs a gas with `inflow_levels` (a defluidization/fluidization cycle)",
+                job.metrics[k]
+            ),
+        ));
+    }
     if let Some(k) = job.metrics.iter().position(|m| m == "coating_variability")
         && !sprayed
     {

@@ -196,6 +196,16 @@ pub fn metrics(job: &JobSpec, built: &BuiltScenario, sim: &Simulation, series: &
             }
             wet if wet.starts_with("granular_") || wet == "wet_phase_mixed" => wet_number(wet, job, built, sim),
             "coating_variability" => crate::engine::spray::coating_variability(&sim.particles.sprayed_m3),
+            "defluidization_velocity_m_per_s" => {
+                cycle(built, sim, series).map_or(f64::NAN, |c| c.defluidization_m_per_s)
+            }
+            "fluidization_velocity_theoretical_m_per_s" => {
+                cycle(built, sim, series).map_or(f64::NAN, |c| c.fluidization_theoretical_m_per_s)
+            }
+            "incipient_fluidization_velocity_m_per_s" => {
+                cycle(built, sim, series).map_or(f64::NAN, |c| c.incipient_m_per_s)
+            }
+            "pressure_overshoot_ratio" => cycle(built, sim, series).map_or(f64::NAN, |c| c.overshoot_ratio),
             other => return Err(Error::External(format!("metric `{other}` has no reducer"))),
         };
         out.push(Metric {
@@ -296,6 +306,39 @@ fn inlet_velocity_m_per_s(sim: &Simulation) -> Option<f64> {
         Boundary::Inlet { velocity_m_per_s } => Some(velocity_m_per_s.iter().map(|v| v * v).sum::<f64>().sqrt()),
         _ => None,
     }
+}
+
+/// Seed 001's cycle velocities from the series: each level of `gas.inflow_levels` is represented by the mean
+/// pressure drop over the second half of its hold (CHOICE: the first half lets the bed respond; seed 001
+/// time-averages each 0.1 s level at "statistical steady state") at the inlet velocity times the level's factor.
+fn cycle(built: &BuiltScenario, sim: &Simulation, series: &Series) -> Option<analysis::fluidization::CycleVelocities> {
+    let gas = built.spec.gas.as_ref()?;
+    let levels = gas.inflow_levels.as_ref()?;
+    let u = inlet_velocity_m_per_s(sim)?;
+    let (t, dp) = (series.column("time_s")?, series.column("column_pressure_drop_pa")?);
+    let points: Vec<analysis::fluidization::CycleLevel> = levels
+        .factors
+        .iter()
+        .enumerate()
+        .filter_map(|(k, factor)| {
+            let (from, to) = (
+                levels.start_s + (k as f64 + 0.5) * levels.hold_s,
+                levels.start_s + (k as f64 + 1.0) * levels.hold_s,
+            );
+            let window: Vec<f64> = t
+                .iter()
+                .zip(dp)
+                .filter(|(t, v)| **t >= from && **t < to && v.is_finite())
+                .map(|(_, v)| *v)
+                .collect();
+            let ramp = gas.inflow_ramp.map_or(1.0, |r| r.factor(from));
+            (!window.is_empty()).then(|| analysis::fluidization::CycleLevel {
+                velocity_m_per_s: u * factor * ramp,
+                pressure_drop_mean_pa: mean(&window),
+            })
+        })
+        .collect();
+    (points.len() >= 3).then(|| analysis::fluidization::cycle_velocities(&points, bed_weight_per_area_pa(built, sim)))
 }
 
 /// W/A: the particles' weight over the area of the inlet side (seed 000 eq 2.74).
