@@ -61,6 +61,18 @@ const RATE_MAX_TIMES_SPACING: f64 = 30.0;
 /// # Panics
 /// If the slices differ in length.
 pub fn fit_exponential_decay(t_s: &[f64], y: &[f64]) -> Option<ExponentialFit> {
+    fit(t_s, y, None)
+}
+
+/// [`fit_exponential_decay`] with the asymptote fixed at `offset`: y = offset + amplitude·exp(−k (t − t_0)). For
+/// IS(t) with the offset at the random mixture's level √(P(1−P)/n) (n particles per local sample), k measures
+/// the approach to a random mixture, and a bed that stalls above it (cohesive agglomerates) gets a small k where
+/// the free-offset fit would report how fast it reached its own plateau.
+pub fn fit_exponential_decay_to(t_s: &[f64], y: &[f64], offset: f64) -> Option<ExponentialFit> {
+    fit(t_s, y, Some(offset))
+}
+
+fn fit(t_s: &[f64], y: &[f64], fixed_offset: Option<f64>) -> Option<ExponentialFit> {
     assert_eq!(t_s.len(), y.len(), "fit_exponential_decay: one y per time");
     let (t, y): (Vec<f64>, Vec<f64>) = t_s
         .iter()
@@ -93,7 +105,11 @@ pub fn fit_exponential_decay(t_s: &[f64], y: &[f64]) -> Option<ExponentialFit> {
     if !(ln_k_lo.is_finite() && ln_k_hi.is_finite() && ln_k_hi > ln_k_lo) {
         return None;
     }
-    let sse = |ln_k: f64| linear_part(&tau_s, &y, ln_k.exp()).2;
+    let linear = |k_per_s: f64| match fixed_offset {
+        None => linear_part(&tau_s, &y, k_per_s),
+        Some(offset) => amplitude_part(&tau_s, &y, k_per_s, offset),
+    };
+    let sse = |ln_k: f64| linear(ln_k.exp()).2;
     let step = (ln_k_hi - ln_k_lo) / (RATE_GRID_POINTS - 1) as f64;
     let grid: Vec<f64> = (0..RATE_GRID_POINTS).map(|i| sse(ln_k_lo + step * i as f64)).collect();
     let best = (0..RATE_GRID_POINTS)
@@ -109,7 +125,7 @@ pub fn fit_exponential_decay(t_s: &[f64], y: &[f64]) -> Option<ExponentialFit> {
         1e-12,
     );
     let k_per_s = ln_k.exp();
-    let (offset, amplitude, sse_min) = linear_part(&tau_s, &y, k_per_s);
+    let (offset, amplitude, sse_min) = linear(k_per_s);
     if !(amplitude != 0.0 && offset.is_finite() && amplitude.is_finite()) {
         return None;
     }
@@ -138,6 +154,20 @@ fn linear_part(tau_s: &[f64], y: &[f64], k_per_s: f64) -> (f64, f64, f64) {
     }
     let amplitude = if see > 1e-300 { sey / see } else { 0.0 };
     let offset = mean_y - amplitude * mean_e;
+    let sse = e
+        .iter()
+        .zip(y)
+        .map(|(ei, yi)| (yi - offset - amplitude * ei).powi(2))
+        .sum();
+    (offset, amplitude, sse)
+}
+
+/// For a fixed rate and offset, the least-squares amplitude of y ≈ offset + amplitude·exp(−k τ) and the SSE.
+fn amplitude_part(tau_s: &[f64], y: &[f64], k_per_s: f64, offset: f64) -> (f64, f64, f64) {
+    let e: Vec<f64> = tau_s.iter().map(|&tau| (-k_per_s * tau).exp()).collect();
+    let see: f64 = e.iter().map(|e| e * e).sum();
+    let sey: f64 = e.iter().zip(y).map(|(e, y)| e * (y - offset)).sum();
+    let amplitude = if see > 1e-300 { sey / see } else { 0.0 };
     let sse = e
         .iter()
         .zip(y)
@@ -399,5 +429,21 @@ mod tests {
         // A NaN sample is skipped: interpolation runs between its neighbours.
         let t = [0.0, 1.0, 2.0, 3.0];
         assert_eq!(time_to_fraction_of_max(&t, &[0.0, f64::NAN, 1.0, 1.0], 0.5), Some(1.0));
+    }
+
+    /// With the asymptote fixed at its true value the rate is recovered; a series that stalls above that asymptote
+    /// gets a smaller rate than the free fit gives it.
+    #[test]
+    fn a_fixed_asymptote_recovers_the_rate_and_penalises_a_stall() {
+        let t: Vec<f64> = (0..80).map(|i| 0.05 * i as f64).collect();
+        let y: Vec<f64> = t.iter().map(|t| 0.15 + 0.35 * (-1.3 * t).exp()).collect();
+        let f = fit_exponential_decay_to(&t, &y, 0.15).unwrap();
+        assert!((f.rate_constant_per_s - 1.3).abs() < 1e-6, "{f:?}");
+        // Fast drop to a plateau at 0.25: the free fit sees a fast decay, the fixed one a slow approach to 0.15.
+        let stall: Vec<f64> = t.iter().map(|t| 0.25 + 0.25 * (-3.0 * t).exp()).collect();
+        let free = fit_exponential_decay(&t, &stall).unwrap();
+        let fixed = fit_exponential_decay_to(&t, &stall, 0.15).unwrap();
+        assert!((free.rate_constant_per_s - 3.0).abs() < 1e-6);
+        assert!(fixed.rate_constant_per_s < 0.5 * free.rate_constant_per_s, "{fixed:?}");
     }
 }

@@ -109,6 +109,13 @@ pub const METRICS: &[MetricInfo] = &[
         needs_gas: false,
     },
     MetricInfo {
+        name: "mixing_rate_to_random_per_s",
+        unit: "1/s",
+        description: "k of IS(t) = IS_R + b exp(-k t) with IS_R = sqrt(P(1-P)/n) the random mixture's IS (n particles per local sample): the approach to a random mixture",
+        needs_mixing: true,
+        needs_gas: false,
+    },
+    MetricInfo {
         name: "time_to_90pct_max_lacey_s",
         unit: "s",
         description: "first time the Lacey index reaches 90 % of its maximum (seed 000 Table 1)",

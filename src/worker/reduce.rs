@@ -177,6 +177,12 @@ pub fn metrics(job: &JobSpec, built: &BuiltScenario, sim: &Simulation, series: &
             "mixing_rate_constant_per_s" => mixing_series()
                 .and_then(|(t, is, _)| analysis::fit::fit_exponential_decay(&t, &is))
                 .map_or(f64::NAN, |f| f.rate_constant_per_s),
+            "mixing_rate_to_random_per_s" => {
+                let random = random_mixture_intensity(job, sim);
+                mixing_series()
+                    .and_then(|(t, is, _)| analysis::fit::fit_exponential_decay_to(&t, &is, random))
+                    .map_or(f64::NAN, |f| f.rate_constant_per_s)
+            }
             "time_to_90pct_max_lacey_s" => mixing_series()
                 .and_then(|(t, _, lacey)| analysis::fit::time_to_fraction_of_max(&t, &lacey, 0.9))
                 .map_or(f64::NAN, |t| t),
@@ -306,6 +312,25 @@ fn inlet_velocity_m_per_s(sim: &Simulation) -> Option<f64> {
         Boundary::Inlet { velocity_m_per_s } => Some(velocity_m_per_s.iter().map(|v| v * v).sum::<f64>().sqrt()),
         _ => None,
     }
+}
+
+/// IS of a random mixture, √(P(1−P)/n): P the volume fraction of the mixing species, n the particles of one local
+/// sample (the particle and its `mixing_neighbours` nearest neighbours).
+fn random_mixture_intensity(job: &JobSpec, sim: &Simulation) -> f64 {
+    let p = &sim.particles;
+    let Some(a) = job
+        .analysis
+        .mixing_species
+        .as_ref()
+        .and_then(|name| sim.config.species.find(name))
+    else {
+        return f64::NAN;
+    };
+    let volume = |keep: &dyn Fn(usize) -> bool| -> f64 {
+        (0..p.len()).filter(|&i| keep(i)).map(|i| p.radius_m[i].powi(3)).sum()
+    };
+    let fraction = volume(&|i| p.species[i] == a) / volume(&|_| true);
+    (fraction * (1.0 - fraction) / (job.analysis.mixing_neighbours + 1) as f64).sqrt()
 }
 
 /// Seed 001's cycle velocities from the series: each level of `gas.inflow_levels` is represented by the mean
