@@ -154,12 +154,15 @@ fn linear_part(tau_s: &[f64], y: &[f64], k_per_s: f64) -> (f64, f64, f64) {
     }
     let amplitude = if see > 1e-300 { sey / see } else { 0.0 };
     let offset = mean_y - amplitude * mean_e;
-    let sse = e
-        .iter()
+    (offset, amplitude, residual_sum_of_squares(&e, y, offset, amplitude))
+}
+
+/// Σ (y − offset − amplitude·e)².
+fn residual_sum_of_squares(e: &[f64], y: &[f64], offset: f64, amplitude: f64) -> f64 {
+    e.iter()
         .zip(y)
         .map(|(ei, yi)| (yi - offset - amplitude * ei).powi(2))
-        .sum();
-    (offset, amplitude, sse)
+        .sum()
 }
 
 /// For a fixed rate and offset, the least-squares amplitude of y ≈ offset + amplitude·exp(−k τ) and the SSE.
@@ -168,12 +171,7 @@ fn amplitude_part(tau_s: &[f64], y: &[f64], k_per_s: f64, offset: f64) -> (f64, 
     let see: f64 = e.iter().map(|e| e * e).sum();
     let sey: f64 = e.iter().zip(y).map(|(e, y)| e * (y - offset)).sum();
     let amplitude = if see > 1e-300 { sey / see } else { 0.0 };
-    let sse = e
-        .iter()
-        .zip(y)
-        .map(|(ei, yi)| (yi - offset - amplitude * ei).powi(2))
-        .sum();
-    (offset, amplitude, sse)
+    (offset, amplitude, residual_sum_of_squares(&e, y, offset, amplitude))
 }
 
 /// Brent's method (golden section with parabolic steps) for a minimum of `f` inside [a, b], to relative tolerance
