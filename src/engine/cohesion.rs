@@ -460,8 +460,7 @@ pub fn apply_cohesion(
             let dist = dist2.sqrt();
             let normal = d / dist;
             let gap = dist - reach;
-            let relative = p.velocity_m_per_s[j];
-            let u = vi - relative;
+            let u = vi - p.velocity_m_per_s[j];
             let approach = -u.dot(&normal);
             let r_star = ri * rj / reach;
             let mut force_on_i = Vec3::zeros();
