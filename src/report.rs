@@ -30,9 +30,18 @@ pub struct CheckResult {
 }
 
 fn same(a: &Value, b: &Value) -> bool {
-    match (a.as_f64(), b.as_f64()) {
-        (Some(x), Some(y)) => (x - y).abs() <= 1e-9 * x.abs().max(y.abs()),
-        _ => a == b,
+    match (a, b) {
+        // A whole section (a map, or null for none) is stored as its JSON text.
+        (Value::String(text), other) | (other, Value::String(text)) if !other.is_string() => {
+            serde_json::from_str::<Value>(text).is_ok_and(|parsed| !parsed.is_string() && same(&parsed, other))
+        }
+        (Value::Object(x), Value::Object(y)) => {
+            x.len() == y.len() && x.iter().all(|(k, v)| y.get(k).is_some_and(|w| same(v, w)))
+        }
+        _ => match (a.as_f64(), b.as_f64()) {
+            (Some(x), Some(y)) => (x - y).abs() <= 1e-9 * x.abs().max(y.abs()),
+            _ => a == b,
+        },
     }
 }
 
@@ -293,5 +302,30 @@ mod tests {
         let result = evaluate(&check, &header, &rows, &[]);
         assert_eq!(result.ours, 3.0 / 8.0);
         assert!(result.pass);
+    }
+
+    /// A swept section (a map, or null for none) is stored as JSON text; `where` and `relative_to` match it by
+    /// value, numbers within 1e-9 and keys in any order.
+    #[test]
+    fn checks_match_whole_sections_by_value() {
+        let header: Vec<String> = ["status", "param.cohesion", "metric.u [m/s]"]
+            .iter()
+            .map(|s| s.to_string())
+            .collect();
+        let row = |c: &str, u: f64| vec![Value::from("done"), Value::from(c), Value::from(u)];
+        let rows = vec![
+            row("null", 0.8),
+            row(r#"{"square_well":{"depth_j":1e-10,"walls":true}}"#, 1.2),
+            row(r#"{"square_well":{"depth_j":1e-11,"walls":true}}"#, 0.9),
+        ];
+        let de = serde_norway::Deserializer::from_str(
+            "{ name: sw over dry, value: { metric: u }, where: { cohesion: { square_well: { walls: true, depth_j: 1.0e-10 } } }, relative_to: { cohesion: null }, expected: 1.5, tolerance_rel: 0.01 }",
+        );
+        let check: CheckSpec = serde_norway::with::singleton_map_recursive::deserialize(de).expect("parses");
+        let result = evaluate(&check, &header, &rows, &[]);
+        assert_eq!((result.ours, result.samples), (1.2 / 0.8, 1));
+        assert!(result.pass);
+        assert!(!same(&Value::from("null"), &serde_json::json!({ "square_well": null })));
+        assert!(!same(&Value::from("text"), &Value::Null));
     }
 }

@@ -63,3 +63,42 @@ fn the_schema_rejects_what_the_parser_rejects() {
     doc["base"]["species"][0]["radius_m"] = serde_json::json!("big");
     assert!(!validator.is_valid(&doc), "a string for a number");
 }
+
+/// A sweep may set an optional section the base leaves out (`cohesion` here: none, or a whole model), and an
+/// unknown top-level key is still refused with the keys that exist.
+#[test]
+fn a_sweep_sets_an_optional_section_whole() {
+    let text = |param: &str| {
+        format!(
+            r#"
+name: sections
+base:
+  domain: {{ lo_m: [0.0, 0.0, 0.0], hi_m: [0.01, 0.01, 0.01] }}
+  gravity: {{ vector_m_per_s2: [0.0, -9.81, 0.0] }}
+  species:
+    - {{ name: s, radius_m: 0.001, density_kg_per_m3: 2500.0, youngs_modulus_pa: 1.0e7, poisson_ratio: 0.3, friction_coefficient: 0.3 }}
+  contact: {{ normal: {{ hertz: {{ restitution: 0.8 }} }}, tangential: mindlin }}
+  fill:
+    - lattice: {{ species: s, spacing_m: 0.003, lo_m: [0.0, 0.0, 0.0], hi_m: [0.01, 0.01, 0.01], origin_m: [0.0015, 0.0015, 0.0015] }}
+  time: {{ dt_s: 1.0e-5, end_time_s: 0.001 }}
+sweep:
+  param: {param}
+  values:
+    - null
+    - {{ hamaker: {{ constant_j: 1.0e-19, inner_cutoff_m: 4.0e-10, outer_cutoff_m: 1.0e-6 }} }}
+metrics: [kinetic_energy_j]
+"#
+        )
+    };
+    let path = std::path::Path::new("sections.yaml");
+    let campaign = granflow::campaign::from_yaml(&text("cohesion"), path).expect("the sweep expands");
+    assert_eq!(campaign.jobs.len(), 2);
+    assert!(campaign.jobs[0].scenario.cohesion.is_none());
+    assert_eq!(campaign.jobs[1].scenario.cohesion.map(|c| c.name()), Some("hamaker"));
+    let err = granflow::campaign::from_yaml(&text("cohesoin"), path).expect_err("a typo is refused");
+    let message = err.to_string();
+    assert!(
+        message.contains("sweep") && message.contains("no `cohesoin`") && message.contains("did you mean `cohesion`"),
+        "{message}"
+    );
+}

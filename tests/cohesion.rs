@@ -240,6 +240,35 @@ fn a_liquid_bridge_holds_two_beads_at_the_hertz_capillary_balance() {
     );
 }
 
+/// With `capillary_force: young_laplace` the bridge pulls with the exact Young–Laplace force of the pair's table
+/// (seed 000 eqs 6.5–6.28) instead of Mikami's fit: the beads rest where the Hertz force balances the table's force
+/// at contact, which for equal beads at θ = 0 is within 5 % of Mikami's (VALIDATION B2).
+#[test]
+fn a_young_laplace_bridge_holds_two_beads_at_its_own_balance() {
+    let mut sim = two_beads(&pair(
+        "{ liquid_bridge: { surface_tension_n_per_m: 0.072, viscosity_pa_s: 0.01, capillary_force: young_laplace } }",
+        1.0e-6,
+        ", liquid_content: 0.02",
+    ));
+    sim.particles.velocity_m_per_s[0].x = 0.005;
+    sim.particles.velocity_m_per_s[1].x = -0.005;
+    sim.run_steps(200_000).expect("stable");
+    let s = sim.snapshot();
+    assert_eq!(s.cohesion.pairs.len(), 1, "one bridge");
+    let volume = s.cohesion.pairs[0].2.bridge_volume_m3;
+    let table = granflow::engine::models::capillary_table::CapillaryTable::new(0.001, 0.001, 0.0, 0.0);
+    let capillary = table.force_n(volume, 0.0, 0.072);
+    let overlap = 0.002 - (s.particles.position_m[0] - s.particles.position_m[1]).norm();
+    let (r_star, e_star) = (0.0005f64, 1.0e7 / (2.0 * (1.0 - 0.09)));
+    let expected = (capillary / (4.0 / 3.0 * e_star * r_star.sqrt())).powf(2.0 / 3.0);
+    assert!((overlap / expected - 1.0).abs() < 0.01, "{overlap} vs {expected}");
+    let mikami = mikami_force_n(r_star, volume, 0.0, 0.0, 0.072);
+    assert!(
+        (capillary / mikami - 1.0).abs() < 0.05,
+        "{capillary} vs Mikami {mikami}"
+    );
+}
+
 /// Square well as crossing impulses (seed 001 §6.2.4.2): a head-on pair approaching at relative speed a₀ gains
 /// 2D/μ of squared speed entering the well, collides with restitution e and escapes with √(e²(a₀² + 2D/μ) − 2D/μ)
 /// if that is real; otherwise it is captured and stays in the well.

@@ -328,3 +328,26 @@ fn cell_averaged_drag_gives_the_same_bits_on_one_and_two_threads() {
         panic!("1 and 2 threads differ: {diff}");
     }
 }
+
+/// Seed 001's distributor: jets through a wall. The side with the jets is the inlet side, the superficial velocity
+/// counts each jet over the whole side (eq 6.41: U = Σ A_jet V_jet / A_b), and the faces between the jets stay shut.
+#[test]
+fn jets_through_a_wall_make_the_inlet_side_and_its_superficial_velocity() {
+    let tmp = tempfile::tempdir().expect("temp dir");
+    let dir = tmp.path();
+    // One jet of 10 m/s through the second of four cells: U = 10/4 = 2.5 m/s.
+    let text = bed(
+        0.002,
+        "  jets: [ { side: y_low, lo_m: [0.0076, 0.0, 0.0], hi_m: [0.0149, 0.0, 0.0027], superficial_velocity_m_per_s: 10.0 } ]",
+    )
+    .replace("y_low: { inlet: { superficial_velocity_m_per_s: 2.5 } }", "y_low: wall");
+    assert!(text.contains("y_low: wall"));
+    let b = common::built(&text);
+    let mut sim = common::simulation(&b, 1);
+    granflow::simulate::attach_gas(&b, &mut sim, None).expect("the gas attaches");
+    let gas = sim.gas.as_ref().expect("a gas");
+    assert_eq!(gas.inlet_side(), Some((1, false)));
+    assert_eq!(gas.superficial_inflow_m_per_s(), Some(2.5));
+    let gas = final_gas(dir, "wall-jet", &text);
+    assert_eq!(&gas.velocity_m_per_s[1][..4], &[0.0, 10.0, 0.0, 0.0]);
+}

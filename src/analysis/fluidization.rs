@@ -84,16 +84,19 @@ pub struct CycleVelocities {
     pub defluidization_m_per_s: f64,
     /// U_mf,th: the same on the rising branch.
     pub fluidization_theoretical_m_per_s: f64,
-    /// U_mf,in: the velocity of the largest pressure drop on the rising branch, if it exceeds W/A (the overshoot
-    /// peak); NaN without an overshoot.
+    /// U_mf,in: the velocity of the largest pressure drop on the rising branch up to 1.25 U_mf,th, if it exceeds
+    /// W/A (the overshoot peak); NaN without an overshoot.
     pub incipient_m_per_s: f64,
-    /// The largest pressure drop on the rising branch over W/A (above 1: an overshoot).
+    /// The largest pressure drop on the rising branch up to 1.25 U_mf,th over W/A (above 1: an overshoot).
     pub overshoot_ratio: f64,
 }
 
 /// The packed-bed points of a branch (CHOICE: seed 001 fits "all packed-bed points" without a rule; here those with
 /// a positive velocity and ΔP below 0.8 W/A, clear of the transition) need at least two for a line.
 const PACKED_FRACTION_OF_WEIGHT: f64 = 0.8;
+
+/// The overshoot region's upper end over U_mf,th.
+const OVERSHOOT_REGION_OVER_UMF: f64 = 1.25;
 
 /// U_mf,df, U_mf,th, U_mf,in and the overshoot from the levels of one cycle in time order. The falling branch runs
 /// from the start to the first slowest level, the rising branch from there on.
@@ -126,14 +129,23 @@ pub fn cycle_velocities(levels: &[CycleLevel], bed_weight_per_area_pa: f64) -> C
             f64::NAN
         }
     };
+    let fluidization_theoretical_m_per_s = crossing(rising);
+    // Seed 001's overshoot region lies left of the bubbling region; CHOICE: levels up to 1.25 U_mf,th (all of the
+    // rising branch when U_mf,th is undefined), so that pressure swings of the bubbling bed at the top of the cycle
+    // do not count as an overshoot.
+    let reach = if fluidization_theoretical_m_per_s.is_finite() {
+        OVERSHOOT_REGION_OVER_UMF * fluidization_theoretical_m_per_s
+    } else {
+        f64::INFINITY
+    };
     let peak = rising
         .iter()
-        .filter(|l| l.pressure_drop_mean_pa.is_finite())
+        .filter(|l| l.pressure_drop_mean_pa.is_finite() && l.velocity_m_per_s <= reach)
         .max_by(|a, b| a.pressure_drop_mean_pa.total_cmp(&b.pressure_drop_mean_pa));
     let overshoot_ratio = peak.map_or(f64::NAN, |l| l.pressure_drop_mean_pa / bed_weight_per_area_pa);
     CycleVelocities {
         defluidization_m_per_s: crossing(falling),
-        fluidization_theoretical_m_per_s: crossing(rising),
+        fluidization_theoretical_m_per_s,
         incipient_m_per_s: match peak {
             Some(l) if overshoot_ratio > 1.0 => l.velocity_m_per_s,
             _ => f64::NAN,
@@ -202,7 +214,8 @@ mod tests {
         for u in [0.2, 0.6, 1.0, 1.2] {
             levels.push(level(u, 600.0 * u));
         }
-        levels.extend([level(1.8, 1150.0), level(2.0, 1005.0), level(2.2, 998.0)]);
+        // A bubbling swing at 2.2 m/s (beyond 1.25 U_mf,th = 2.08) is not an overshoot.
+        levels.extend([level(1.8, 1150.0), level(2.0, 1005.0), level(2.2, 1200.0)]);
         let c = cycle_velocities(&levels, 1000.0);
         assert!((c.defluidization_m_per_s - 2.0).abs() < 1e-12, "{c:?}");
         assert!(

@@ -223,14 +223,14 @@ pub const METRICS: &[MetricInfo] = &[
     MetricInfo {
         name: "incipient_fluidization_velocity_m_per_s",
         unit: "m/s",
-        description: "U_mf,in: the velocity of the rising branch's largest pressure drop when it exceeds W/A (the overshoot peak)",
+        description: "U_mf,in: the velocity of the rising branch's largest pressure drop up to 1.25 U_mf,th, when it exceeds W/A (the overshoot peak)",
         needs_mixing: false,
         needs_gas: true,
     },
     MetricInfo {
         name: "pressure_overshoot_ratio",
         unit: "1",
-        description: "the rising branch's largest level-mean pressure drop over W/A (above 1: an overshoot)",
+        description: "the largest level-mean pressure drop of the rising branch up to 1.25 U_mf,th (left of the bubbling bed), over W/A (above 1: an overshoot)",
         needs_mixing: false,
         needs_gas: true,
     },

@@ -283,7 +283,11 @@ fn resolve(
                 "the scenario name is the campaign's (`name` at the top level); it cannot be swept",
             ));
         }
-        sweep::set_path(&mut doc, param, value.clone())
+        // An optional section the base leaves out (`cohesion`, `gas`) may be set whole by the sweep.
+        if let (Some(section), serde_json::Value::Object(map)) = (optional_section(param), &mut doc) {
+            map.entry(section).or_insert(serde_json::Value::Null);
+        }
+        sweep::set_path_with_sections(&mut doc, param, value.clone(), optional_sections())
             .map_err(|m| invalid(path, key, format!("parameter `{param}`: {m}")))?;
     }
     let mut scenario: ScenarioSpec = serde_path_to_error::deserialize(&doc).map_err(|e| {
@@ -320,6 +324,34 @@ fn resolve(
     };
     job.job_id = job.compute_id();
     Ok(job)
+}
+
+/// The top-level key of `param` if it names an optional section of the scenario (one the schema does not
+/// require), which a re-serialised base omits when it is absent.
+fn optional_section(param: &str) -> Option<String> {
+    let first = param.split(['.', '[']).next()?;
+    optional_sections()
+        .iter()
+        .any(|k| k == first)
+        .then(|| first.to_string())
+}
+
+/// The scenario's top-level keys that its schema does not require.
+fn optional_sections() -> &'static [String] {
+    static OPTIONAL: std::sync::OnceLock<Vec<String>> = std::sync::OnceLock::new();
+    OPTIONAL.get_or_init(|| {
+        let schema = schemars::schema_for!(ScenarioSpec);
+        let required: Vec<&str> = schema
+            .get("required")
+            .and_then(|r| r.as_array())
+            .map(|r| r.iter().filter_map(|k| k.as_str()).collect())
+            .unwrap_or_default();
+        schema
+            .get("properties")
+            .and_then(|p| p.as_object())
+            .map(|p| p.keys().filter(|k| !required.contains(&k.as_str())).cloned().collect())
+            .unwrap_or_default()
+    })
 }
 
 fn describe(point: &sweep::Point) -> String {

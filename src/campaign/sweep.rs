@@ -348,6 +348,17 @@ pub fn canonical_path(path: &str) -> Result<String, String> {
 /// Sets `path` in `doc` to `value`. Every segment must already exist (the base scenario, re-serialised, holds every
 /// field including defaults), so a typo is an error listing what exists there instead of a silently ignored key.
 pub fn set_path(doc: &mut Value, path: &str, value: Value) -> Result<(), String> {
+    set_path_with_sections(doc, path, value, &[])
+}
+
+/// As [`set_path`]; `optional_sections`: top-level keys a scenario may have that `doc` leaves out (they are listed
+/// and suggested when a top-level key is unknown).
+pub fn set_path_with_sections(
+    doc: &mut Value,
+    path: &str,
+    value: Value,
+    optional_sections: &[String],
+) -> Result<(), String> {
     let segments = parse_path(path)?;
     let mut here = doc;
     let mut walked = String::new();
@@ -362,7 +373,16 @@ pub fn set_path(doc: &mut Value, path: &str, value: Value) -> Result<(), String>
                     ));
                 };
                 if !map.contains_key(&k) {
-                    let known: Vec<&str> = map.keys().map(|s| s.as_str()).collect();
+                    let mut known: Vec<&str> = map.keys().map(|s| s.as_str()).collect();
+                    if walked.is_empty() {
+                        known.extend(
+                            optional_sections
+                                .iter()
+                                .map(String::as_str)
+                                .filter(|o| !map.contains_key(*o)),
+                        );
+                        known.sort_unstable();
+                    }
                     let hint = did_you_mean(&k, &known)
                         .map(|s| format!("; did you mean `{s}`?"))
                         .unwrap_or_default();

@@ -19,7 +19,8 @@ use super::models::capillary::{
     MikamiBridge, bridge_volume_on_contact_m3, lian_rupture_gap_m, viscous_normal_force_n,
     viscous_tangential_coefficient_n_s_per_m,
 };
-use super::models::cohesion_law::{CohesionModel, square_well_crossing};
+use super::models::capillary_table::CapillaryTable;
+use super::models::cohesion_law::{CapillaryForce, CohesionModel, square_well_crossing};
 use super::models::liquid_transfer::rupture_share_of_i;
 use super::neighbor::NeighborList;
 use super::particles::{ParticleId, Particles, SpeciesId, SpeciesTable};
@@ -39,6 +40,9 @@ pub struct Cohesion {
     pub contact_angle_rad: Vec<f64>,
     /// Rupture shares per unordered species pair a ≤ b, row by row of the upper triangle.
     pub rupture: Vec<RuptureTable>,
+    /// Liquid bridges: the Young–Laplace force table per unordered species pair (indexed as `rupture`), or `None`
+    /// where Mikami's fit applies (equal radius and contact angle, with `capillary_force: auto`).
+    pub capillary: Vec<Option<CapillaryTable>>,
     n_species: usize,
 }
 
@@ -71,6 +75,7 @@ impl Cohesion {
             min_gap_m: 0.0,
             contact_angle_rad,
             rupture: Vec::new(),
+            capillary: Vec::new(),
             n_species: n,
         };
         match model {
@@ -135,6 +140,7 @@ impl Cohesion {
                     largest_angle,
                     largest_angle,
                 );
+                let b_law = b.capillary_force;
                 // One table per unordered pair (a ≤ b): j keeps what i does not.
                 for (ka, a) in species.species.iter().enumerate() {
                     for b in &species.species[ka..] {
@@ -145,6 +151,12 @@ impl Cohesion {
                             b.contact_angle_deg.to_radians(),
                             a == b,
                         ));
+                        let (ta, tb) = (a.contact_angle_deg.to_radians(), b.contact_angle_deg.to_radians());
+                        let unequal = a.radius_m != b.radius_m || ta != tb;
+                        cohesion.capillary.push(
+                            (unequal || b_law == CapillaryForce::YoungLaplace)
+                                .then(|| CapillaryTable::new(a.radius_m, b.radius_m, ta, tb)),
+                        );
                     }
                 }
             }
@@ -182,11 +194,16 @@ impl Cohesion {
         Ok(cohesion)
     }
 
-    /// The share particle i (species `a`) keeps of a breaking bridge of `volume_m3` with a particle of species `b`.
-    fn rupture_share_of_i(&self, a: SpeciesId, b: SpeciesId, volume_m3: f64) -> f64 {
+    /// The index of the unordered species pair {a, b} in the per-pair tables.
+    fn pair_index(&self, a: SpeciesId, b: SpeciesId) -> usize {
         let (lo, hi) = (a.index().min(b.index()), a.index().max(b.index()));
         // Row lo of the upper triangle starts after the rows above it: lo·n − lo(lo−1)/2.
-        let table = &self.rupture[lo * self.n_species - lo * lo.saturating_sub(1) / 2 + (hi - lo)];
+        lo * self.n_species - lo * lo.saturating_sub(1) / 2 + (hi - lo)
+    }
+
+    /// The share particle i (species `a`) keeps of a breaking bridge of `volume_m3` with a particle of species `b`.
+    fn rupture_share_of_i(&self, a: SpeciesId, b: SpeciesId, volume_m3: f64) -> f64 {
+        let table = &self.rupture[self.pair_index(a, b)];
         let share = table.share_of_i(volume_m3);
         if a.index() <= b.index() { share } else { 1.0 - share }
     }
@@ -314,6 +331,8 @@ struct BridgeConstants {
     /// The volume these were computed for (NaN: none).
     volume_m3: f64,
     mikami: MikamiBridge,
+    /// The pair's Young–Laplace table (index into `Cohesion::capillary`), used instead of `mikami`.
+    table: Option<u32>,
     rupture_gap_m: f64,
 }
 
@@ -321,6 +340,7 @@ impl BridgeConstants {
     const NONE: BridgeConstants = BridgeConstants {
         volume_m3: f64::NAN,
         mikami: MikamiBridge::ZERO,
+        table: None,
         rupture_gap_m: 0.0,
     };
 }
@@ -482,8 +502,7 @@ pub fn apply_cohesion(
                     }
                     let constants = &mut state.bridges[k];
                     if slot.bridge_volume_m3 > 0.0 && constants.volume_m3 != slot.bridge_volume_m3 {
-                        // CHOICE: Mikami's fit is for equal wetting; unequal angles use their mean until the
-                        // Young–Laplace table replaces it.
+                        let pair = cohesion.pair_index(si, sj);
                         *constants = BridgeConstants {
                             volume_m3: slot.bridge_volume_m3,
                             mikami: MikamiBridge::new(
@@ -492,6 +511,7 @@ pub fn apply_cohesion(
                                 0.5 * (ti + tj),
                                 b.surface_tension_n_per_m,
                             ),
+                            table: cohesion.capillary[pair].is_some().then_some(pair as u32),
                             rupture_gap_m: lian_rupture_gap_m(slot.bridge_volume_m3, ti, tj).min(cohesion.range_m),
                         };
                     }
@@ -504,7 +524,13 @@ pub fn apply_cohesion(
                         pass.bridges_ruptured += 1;
                     }
                     if slot.bridge_volume_m3 > 0.0 {
-                        let mut normal_force = -constants.mikami.force_n(gap);
+                        let capillary = match constants.table {
+                            Some(t) => cohesion.capillary[t as usize].as_ref().map_or(0.0, |table| {
+                                table.force_n(slot.bridge_volume_m3, gap, b.surface_tension_n_per_m)
+                            }),
+                            None => constants.mikami.force_n(gap),
+                        };
+                        let mut normal_force = -capillary;
                         if b.viscosity_pa_s > 0.0 {
                             normal_force +=
                                 viscous_normal_force_n(r_star, b.viscosity_pa_s, approach, gap, cohesion.min_gap_m);

@@ -692,7 +692,8 @@ fn fill(
                     drum_named(c, &key("inside_drum"), walls, d)?;
                 }
                 let r = sp.radius_m;
-                let region_volume: f64 = (0..3).map(|a| (hi_m[a] - lo_m[a]).max(0.0)).product();
+                // Centres confined to a plane (a pseudo-2-D layer) still fill a slab one diameter thick.
+                let region_volume: f64 = (0..3).map(|a| (hi_m[a] - lo_m[a]).max(2.0 * r)).product();
                 let solid = *count as f64 * 4.0 / 3.0 * PI * r.powi(3);
                 if solid > 0.6 * region_volume {
                     return Err(c.fail(

@@ -480,10 +480,10 @@ pub fn build_gas(
     }
     if let Some(h) = spec.pressure_probe_height_m {
         positive("pressure_probe_height_m", h)?;
-        if !boundary.iter().any(|b| matches!(b, Boundary::Inlet { .. })) {
+        if !boundary.iter().any(|b| matches!(b, Boundary::Inlet { .. })) && inlet_faces.is_empty() {
             return Err(fail(
                 "gas.pressure_probe_height_m".into(),
-                "the probe height is measured from an inlet side; no side is an inlet".into(),
+                "the probe height is measured from an inlet side; no side is an inlet or has a jet".into(),
             ));
         }
     }

@@ -8,7 +8,6 @@ use crate::analysis;
 use crate::campaign::JobSpec;
 use crate::campaign::metrics::info;
 use crate::engine::Simulation;
-use crate::engine::gas::grid::{Boundary, side};
 use crate::engine::models::cohesion_law::CohesionModel;
 use crate::engine::particles::SpeciesId;
 use crate::error::Error;
@@ -306,12 +305,7 @@ fn wet_number(name: &str, job: &JobSpec, built: &BuiltScenario, sim: &Simulation
 /// The superficial velocity of the gas entering through the inlet side, m/s (the magnitude of the prescribed
 /// inflow; `None` without a gas or an inlet side).
 fn inlet_velocity_m_per_s(sim: &Simulation) -> Option<f64> {
-    let gas = sim.gas.as_ref()?;
-    let (axis, high) = gas.inlet_side()?;
-    match gas.solver.config.grid.boundary[side(axis, high)] {
-        Boundary::Inlet { velocity_m_per_s } => Some(velocity_m_per_s.iter().map(|v| v * v).sum::<f64>().sqrt()),
-        _ => None,
-    }
+    sim.gas.as_ref()?.superficial_inflow_m_per_s()
 }
 
 /// IS of a random mixture, √(P(1−P)/n): P the volume fraction of the mixing species, n the particles of one local

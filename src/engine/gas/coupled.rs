@@ -252,12 +252,49 @@ impl GasCoupling {
         Ok(())
     }
 
-    /// The axis and side of the first inlet: the bed's vertical and its bottom.
+    /// The axis and side of the first inlet (the bed's vertical and its bottom): a side with uniform inflow, or
+    /// else the side of the first jet (seed 001's distributor: jets through a wall).
     pub fn inlet_side(&self) -> Option<(usize, bool)> {
         let grid = &self.solver.config.grid;
         (0..grid.axes())
             .flat_map(|a| [(a, false), (a, true)])
             .find(|&(a, high)| matches!(grid.boundary[side(a, high)], Boundary::Inlet { .. }))
+            .or_else(|| {
+                self.solver.config.inlet_faces.first().map(|f| {
+                    let along = super::simple::face_index(grid, f.axis, f.face)[f.axis];
+                    (f.axis, along == grid.n[f.axis])
+                })
+            })
+    }
+
+    /// The superficial velocity U of the inlet side at full inflow (no ramp or level factor): the inflow through
+    /// its faces, jets at their own velocity, over the side's area (seed 001 eq 6.41, U_s = Σ A_jet V_jet / A_b), m/s.
+    pub fn superficial_inflow_m_per_s(&self) -> Option<f64> {
+        let (axis, high) = self.inlet_side()?;
+        let grid = &self.solver.config.grid;
+        let uniform = match grid.boundary[side(axis, high)] {
+            Boundary::Inlet { velocity_m_per_s } => velocity_m_per_s[axis].abs(),
+            _ => 0.0,
+        };
+        let dims = grid.face_dims(axis);
+        let along = if high { grid.n[axis] } else { 0 };
+        let mut faces = vec![uniform; grid.faces(axis)];
+        for f in self.solver.config.inlet_faces.iter().filter(|f| f.axis == axis) {
+            faces[f.face] = f.velocity_m_per_s.abs();
+        }
+        let (mut sum, mut count) = (0.0, 0usize);
+        for k in 0..dims[2] {
+            for j in 0..dims[1] {
+                for i in 0..dims[0] {
+                    let idx = [i, j, k];
+                    if idx[axis] == along {
+                        sum += faces[grid.face(axis, idx)];
+                        count += 1;
+                    }
+                }
+            }
+        }
+        (count > 0).then(|| sum / count as f64)
     }
 
     /// Mean pressure of the layer of cells `layer` along `axis`, Pa.

@@ -821,7 +821,7 @@ fn face_touches_blocked(grid: &Grid, blocked: &[bool], axis: usize, idx: [usize;
 }
 
 /// The (i, j, k) of face `f` of the component along `axis`.
-fn face_index(grid: &Grid, axis: usize, f: usize) -> [usize; 3] {
+pub(crate) fn face_index(grid: &Grid, axis: usize, f: usize) -> [usize; 3] {
     let d = grid.face_dims(axis);
     [f % d[0], (f / d[0]) % d[1], f / (d[0] * d[1])]
 }

@@ -36,6 +36,27 @@ pub struct LiquidBridge {
     /// Liquid sprayed onto the bed's free surface (seed 000 §6.3.2); absent: none.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub spray: Option<Spray>,
+    /// Which capillary force law bridges use (default `auto`).
+    #[serde(default, skip_serializing_if = "CapillaryForce::is_auto")]
+    pub capillary_force: CapillaryForce,
+}
+
+/// The capillary force law of liquid bridges.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize, schemars::JsonSchema)]
+#[serde(rename_all = "snake_case")]
+pub enum CapillaryForce {
+    /// Mikami's fit (seed 000 eqs 2.16–2.17) between particles of equal radius and contact angle, the
+    /// Young–Laplace table (eqs 6.5–6.28) between unequal ones.
+    #[default]
+    Auto,
+    /// The Young–Laplace table for every pair (e.g. contact angles above 0, where Mikami's θ² term is not settled).
+    YoungLaplace,
+}
+
+impl CapillaryForce {
+    fn is_auto(&self) -> bool {
+        *self == CapillaryForce::Auto
+    }
 }
 
 /// Spray from above (seed 000 §6.3.2): at every spray step the particles on the bed's free surface get their liquid
