@@ -14,7 +14,7 @@ use granflow::engine::state::{SimState, first_difference};
 
 /// A wet rotating drum: two species of 3 mm beads (contact angles 20° and 50°) carrying V̂ = 0.01 of water each,
 /// the lattice collapsing into the drum's bed while it turns, the bed's surface sprayed up to V̂ = 0.02 every 50
-/// steps.
+/// steps, with bridges to the drum and its baffles as well.
 const WET_DRUM: &str = r#"
 name: wet-drum
 domain: { lo_m: [-0.041, -0.041, 0.0], hi_m: [0.041, 0.041, 0.012], periodic: [false, false, true] }
@@ -23,7 +23,7 @@ species:
   - { name: a, radius_m: 0.0015, density_kg_per_m3: 2500.0, youngs_modulus_pa: 5.0e7, poisson_ratio: 0.3, friction_coefficient: 0.4, contact_angle_deg: 20.0, liquid_content: 0.01 }
   - { name: b, radius_m: 0.0015, density_kg_per_m3: 2500.0, youngs_modulus_pa: 5.0e7, poisson_ratio: 0.3, friction_coefficient: 0.4, contact_angle_deg: 50.0, liquid_content: 0.01 }
 contact: { normal: { hertz: { restitution: 0.6 } }, tangential: mindlin }
-cohesion: { liquid_bridge: { surface_tension_n_per_m: 0.072, viscosity_pa_s: 0.001, spray: { max_liquid_content: 0.02, every_steps: 50 } } }
+cohesion: { liquid_bridge: { surface_tension_n_per_m: 0.072, viscosity_pa_s: 0.001, walls: true, spray: { max_liquid_content: 0.02, every_steps: 50 } } }
 walls:
   - drum:
       name: drum
@@ -90,11 +90,12 @@ fn b4_liquid_is_conserved_while_bridges_form_and_break() {
         .map(|(l, _)| l)
         .sum();
     println!(
-        "B4: {} particles, {} bridges formed, {} broken, {} standing, liquid drift {worst:e}; the 50° species holds {:.3} of the particles' liquid",
+        "B4: {} particles, {} bridges formed, {} broken, {} standing ({} to walls), liquid drift {worst:e}; the 50° species holds {:.3} of the particles' liquid",
         s.particles.len(),
         events.bridges_formed,
         events.bridges_ruptured,
-        s.cohesion.pairs.len(),
+        s.cohesion.pairs.len() + s.cohesion.walls.len(),
+        s.cohesion.walls.len(),
         on_b / s.particles.liquid_m3.iter().sum::<f64>()
     );
     assert!(
@@ -102,6 +103,7 @@ fn b4_liquid_is_conserved_while_bridges_form_and_break() {
         "{events:?}"
     );
     assert!(worst < 1e-10, "liquid drifted by {worst:e} of the total");
+    assert!(!s.cohesion.walls.is_empty(), "bridges to the drum stand");
 }
 
 fn final_state(dir: &Path) -> SimState {
@@ -139,6 +141,7 @@ fn a_wet_drum_restarts_bit_identically_on_any_thread_count() {
     ]);
     let middle = final_state(&dir.join("split"));
     assert!(middle.cohesion.pairs.len() > 50, "bridges cross the restart");
+    assert!(!middle.cohesion.walls.is_empty(), "bridges to walls cross the restart");
     run(&["simulate", "wet.yaml", "--out", "split", "--threads", "1", "--quiet"]);
     let whole = final_state(&dir.join("whole"));
     let split = final_state(&dir.join("split"));
@@ -307,4 +310,54 @@ fn square_well_pairs_escape_or_are_captured_as_the_energy_balance_says() {
             assert!(separation < 0.002 * 1.01 + 1e-6, "still in the well: {separation}");
         }
     }
+}
+
+/// A wet bead on a floor, with `walls: true`: a bridge to the wall forms on contact with half the bead's liquid and
+/// the bead rests where the Hertz force balances its weight plus Mikami's force for a plane (R* = R); liquid on the
+/// bead plus the bridge stays what the bead started with. With the default (no wall bridges) nothing forms.
+#[test]
+fn a_wet_bead_bridges_to_the_floor_only_when_wall_bridges_are_on() {
+    let yaml = |walls: bool| {
+        format!(
+            r#"
+name: bead-on-floor
+domain: {{ lo_m: [-0.005, 0.0, -0.005], hi_m: [0.005, 0.01, 0.005] }}
+gravity: {{ vector_m_per_s2: [0.0, -9.81, 0.0] }}
+species:
+  - {{ name: s, radius_m: 0.001, density_kg_per_m3: 2500.0, youngs_modulus_pa: 1.0e7, poisson_ratio: 0.3, friction_coefficient: 0.3, contact_angle_deg: 10.0, liquid_content: 0.02 }}
+contact: {{ normal: {{ hertz: {{ restitution: 0.5 }} }}, tangential: mindlin }}
+walls: [ {{ box: {{ species: s }} }} ]
+cohesion: {{ liquid_bridge: {{ surface_tension_n_per_m: 0.072, viscosity_pa_s: 0.01, walls: {walls} }} }}
+fill:
+  - lattice: {{ species: s, spacing_m: 0.004, lo_m: [-0.001, 0.0012, -0.001], hi_m: [0.001, 0.0014, 0.001], origin_m: [0.0, 0.0013, 0.0] }}
+time: {{ dt_s: 1.0e-6, end_time_s: 1.0 }}
+"#
+        )
+    };
+    let liquid = 0.02e-9;
+    let mut dry_walls = simulation(&built(&yaml(false)), 1);
+    dry_walls.run_steps(50_000).expect("stable");
+    assert!(
+        dry_walls.snapshot().cohesion.walls.is_empty(),
+        "no wall bridge by default"
+    );
+    let b = built(&yaml(true));
+    assert_eq!(b.particles.len(), 1);
+    let mut sim = simulation(&b, 1);
+    sim.run_steps(300_000).expect("stable");
+    let s = sim.snapshot();
+    assert_eq!(s.cohesion.walls.len(), 1, "one bridge, to the floor");
+    let volume = s.cohesion.walls[0].2.bridge_volume_m3;
+    assert!((volume / (0.5 * liquid) - 1.0).abs() < 1e-12, "{volume}");
+    assert!(((s.particles.liquid_m3[0] + volume) / liquid - 1.0).abs() < 1e-12);
+    let overlap = 0.001 - s.particles.position_m[0].y;
+    let (r, e_star) = (0.001f64, 1.0e7 / (2.0 * (1.0 - 0.09)));
+    let weight = 2500.0 * 4.0 / 3.0 * PI * r.powi(3) * 9.81;
+    let capillary = mikami_force_n(r, volume, 0.0, 10f64.to_radians(), 0.072);
+    let expected = ((weight + capillary) / (4.0 / 3.0 * e_star * r.sqrt())).powf(2.0 / 3.0);
+    assert!((overlap / expected - 1.0).abs() < 0.01, "{overlap} vs {expected}");
+    assert!(
+        capillary > 3.0 * weight,
+        "the bridge, more than the weight, presses the bead down"
+    );
 }

@@ -140,6 +140,7 @@ impl Cohesion {
                     largest_angle,
                     largest_angle,
                 );
+                cohesion.wall_range_m = if b.walls { cohesion.range_m } else { 0.0 };
                 let b_law = b.capillary_force;
                 // One table per unordered pair (a ≤ b): j keeps what i does not.
                 for (ka, a) in species.species.iter().enumerate() {
@@ -421,7 +422,9 @@ impl AlignedCohesion {
 
 /// Liquid on the particles and in the bridges, m³.
 pub fn total_liquid_m3(liquid_m3: &[f64], state: &AlignedCohesion) -> f64 {
-    liquid_m3.iter().sum::<f64>() + state.pair.iter().map(|s| s.bridge_volume_m3).sum::<f64>()
+    liquid_m3.iter().sum::<f64>()
+        + state.pair.iter().map(|s| s.bridge_volume_m3).sum::<f64>()
+        + state.wall.iter().map(|s| s.bridge_volume_m3).sum::<f64>()
 }
 
 /// What a pass did, for diagnostics.
@@ -591,7 +594,46 @@ pub fn apply_cohesion(
                 }
                 let approach = -(vi - prox.wall_velocity).dot(&prox.normal);
                 let force = match cohesion.model {
-                    CohesionModel::LiquidBridge(_) => 0.0,
+                    CohesionModel::LiquidBridge(b) => {
+                        let (ti, tw) = (
+                            cohesion.contact_angle_rad[si.index()],
+                            cohesion.contact_angle_rad[config.walls[w].species.index()],
+                        );
+                        if slot.bridge_volume_m3 == 0.0 && gap < 0.0 && p.liquid_m3[i] > 0.0 {
+                            // Eq 6.1 with R_j → ∞: the cap facing a plane is half the particle.
+                            let taken = 0.5 * p.liquid_m3[i];
+                            p.liquid_m3[i] -= taken;
+                            slot.bridge_volume_m3 = taken;
+                            pass.bridges_formed += 1;
+                        }
+                        let volume = slot.bridge_volume_m3;
+                        if volume > 0.0 && gap > lian_rupture_gap_m(volume, ti, tw).min(cohesion.wall_range_m) {
+                            p.liquid_m3[i] += volume;
+                            slot.bridge_volume_m3 = 0.0;
+                            pass.bridges_ruptured += 1;
+                        }
+                        if slot.bridge_volume_m3 > 0.0 {
+                            let mut f =
+                                -MikamiBridge::new(ri, volume, 0.5 * (ti + tw), b.surface_tension_n_per_m).force_n(gap);
+                            if b.viscosity_pa_s > 0.0 {
+                                f += viscous_normal_force_n(ri, b.viscosity_pa_s, approach, gap, cohesion.min_gap_m);
+                                let coefficient = viscous_tangential_coefficient_n_s_per_m(
+                                    ri,
+                                    b.viscosity_pa_s,
+                                    gap,
+                                    cohesion.min_gap_m,
+                                );
+                                let contact_velocity = vi - prox.wall_velocity - (wi * ri).cross(&prox.normal);
+                                let ut = contact_velocity - prox.normal * contact_velocity.dot(&prox.normal);
+                                let tangential = -ut * coefficient;
+                                p.force_n[i] += tangential;
+                                p.torque_n_m[i] -= prox.normal.cross(&tangential) * ri;
+                            }
+                            f
+                        } else {
+                            0.0
+                        }
+                    }
                     CohesionModel::Hamaker(h) => {
                         if gap < h.outer_cutoff_m {
                             -h.law().wall_force_n(ri, gap)

@@ -39,6 +39,17 @@ pub struct LiquidBridge {
     /// Which capillary force law bridges use (default `auto`).
     #[serde(default, skip_serializing_if = "CapillaryForce::is_auto")]
     pub capillary_force: CapillaryForce,
+    /// Bridges between particles and walls too (default false: seed 000 leaves them out to avoid size effects). A
+    /// wall bridge takes half the particle's liquid on contact (eq 6.1 with the wall as a sphere of infinite
+    /// radius), pulls with Mikami's force at R = 2R_i (a plane is a sphere of R* = R_i) at the mean of the
+    /// particle's and the wall's contact angles, and on rupture returns all of its liquid to the particle (the
+    /// wall is dry: CHOICE, the film a wall would keep is not tracked).
+    #[serde(default, skip_serializing_if = "is_false")]
+    pub walls: bool,
+}
+
+fn is_false(b: &bool) -> bool {
+    !*b
 }
 
 /// The capillary force law of liquid bridges.
@@ -140,11 +151,11 @@ impl CohesionModel {
         }
     }
 
-    /// Whether the model acts between particles and walls. Liquid bridges do not (seed 000 leaves them out to
+    /// Whether the model acts between particles and walls. Liquid bridges do not by default (seed 000 leaves them out to
     /// avoid wall effects in small beds).
     pub fn acts_on_walls(&self) -> bool {
         match self {
-            CohesionModel::LiquidBridge(_) => false,
+            CohesionModel::LiquidBridge(b) => b.walls,
             CohesionModel::Hamaker(h) => h.walls,
             CohesionModel::SquareWell(w) => w.walls,
         }
