@@ -352,7 +352,7 @@ const CASES: &[(&str, &str, &str, &[&str])] = &[
         "rotation_rpm",
         &[
             "key `sweep.grid[0].param`",
-            "no `rotation_rpm` at the top level (there: contact, domain, fill,",
+            "no `rotation_rpm` at the top level (there: cohesion, contact, domain, fill, gas,",
         ],
     ),
     (
