@@ -14,7 +14,10 @@ contact.rolling (optional, default none):
   constant_directional_torque                                            M = mu_r R* F_n; species.rolling_friction_coefficient
 cohesion (optional, one of):
   liquid_bridge: { surface_tension_n_per_m, viscosity_pa_s?, min_gap_m? }  seed 000 eqs. 2.16-2.20, 6.1-6.44;
-                                                                         species.liquid_content, contact_angle_deg
+                 { ..., spray?, capillary_force?, walls? }               species.liquid_content, contact_angle_deg;
+                                                                         capillary_force: auto (Mikami for equal
+                                                                         beads at θ = 0, else the Young-Laplace
+                                                                         table) or young_laplace; walls default false
   hamaker: { constant_j, inner_cutoff_m, outer_cutoff_m, walls? }        seed 001 eqs. 6.34-6.37
   square_well: { depth_j, outer_to_inner_radius_ratio, walls? }          seed 001 eqs. 3.6-3.11 as impulses
 species: { name, radius_m, density_kg_per_m3, youngs_modulus_pa, poisson_ratio, friction_coefficient,
@@ -85,6 +88,7 @@ mod tests {
         }
         for yaml in [
             "liquid_bridge: { surface_tension_n_per_m: 0.072, viscosity_pa_s: 0.001, min_gap_m: 1.0e-5 }",
+            "liquid_bridge: { surface_tension_n_per_m: 0.072, capillary_force: young_laplace, walls: true }",
             "hamaker: { constant_j: 1.0e-18, inner_cutoff_m: 4.0e-10, outer_cutoff_m: 1.0e-4, walls: false }",
             "square_well: { depth_j: 1.0e-10, outer_to_inner_radius_ratio: 1.01, walls: true }",
         ] {

@@ -41,7 +41,7 @@ pub struct Cohesion {
     /// Rupture shares per unordered species pair a ≤ b, row by row of the upper triangle.
     pub rupture: Vec<RuptureTable>,
     /// Liquid bridges: the Young–Laplace force table per unordered species pair (indexed as `rupture`), or `None`
-    /// where Mikami's fit applies (equal radius and contact angle, with `capillary_force: auto`).
+    /// where Mikami's fit applies (equal radii and both contact angles 0, with `capillary_force: auto`).
     pub capillary: Vec<Option<CapillaryTable>>,
     n_species: usize,
 }
@@ -153,9 +153,10 @@ impl Cohesion {
                             a == b,
                         ));
                         let (ta, tb) = (a.contact_angle_deg.to_radians(), b.contact_angle_deg.to_radians());
-                        let unequal = a.radius_m != b.radius_m || ta != tb;
+                        // Mikami's fit only where it is settled: equal particles at θ = 0 (B2).
+                        let mikami_settled = a.radius_m == b.radius_m && ta == 0.0 && tb == 0.0;
                         cohesion.capillary.push(
-                            (unequal || b_law == CapillaryForce::YoungLaplace)
+                            (!mikami_settled || b_law == CapillaryForce::YoungLaplace)
                                 .then(|| CapillaryTable::new(a.radius_m, b.radius_m, ta, tb)),
                         );
                     }
