@@ -206,20 +206,22 @@ fn hamaker_pulls_two_beads_with_the_printed_force() {
     }
 }
 
-/// Two wet beads brought into contact hold together: a bridge forms on contact, and once the viscous liquid has
-/// damped the motion they rest at the overlap where the Hertz force balances Mikami's capillary force at contact.
-#[test]
-fn a_liquid_bridge_holds_two_beads_at_the_hertz_capillary_balance() {
-    let mut sim = two_beads(&pair(
-        "{ liquid_bridge: { surface_tension_n_per_m: 0.072, viscosity_pa_s: 0.01 } }",
-        1.0e-6,
-        ", liquid_content: 0.02",
-    ));
+/// Two beads of V̂ = 0.02 pushed together at 1 cm/s under `cohesion`, after 0.2 s: they hold one bridge.
+fn wet_pair_at_rest(cohesion: &str) -> SimState {
+    let mut sim = two_beads(&pair(cohesion, 1.0e-6, ", liquid_content: 0.02"));
     sim.particles.velocity_m_per_s[0].x = 0.005;
     sim.particles.velocity_m_per_s[1].x = -0.005;
     sim.run_steps(200_000).expect("stable");
     let s = sim.snapshot();
     assert_eq!(s.cohesion.pairs.len(), 1, "one bridge");
+    s
+}
+
+/// Two wet beads brought into contact hold together: a bridge forms on contact, and once the viscous liquid has
+/// damped the motion they rest at the overlap where the Hertz force balances Mikami's capillary force at contact.
+#[test]
+fn a_liquid_bridge_holds_two_beads_at_the_hertz_capillary_balance() {
+    let s = wet_pair_at_rest("{ liquid_bridge: { surface_tension_n_per_m: 0.072, viscosity_pa_s: 0.01 } }");
     let volume = s.cohesion.pairs[0].2.bridge_volume_m3;
     // Each bead gave the liquid on its cap facing the other: (L/2)(1 − √(1 − 1/4)) of L = 0.02 R³.
     let expected_volume = 2.0 * 0.5 * 0.02e-9 * (1.0 - 0.75f64.sqrt());
@@ -248,16 +250,9 @@ fn a_liquid_bridge_holds_two_beads_at_the_hertz_capillary_balance() {
 /// at contact, which for equal beads at θ = 0 is within 5 % of Mikami's (VALIDATION B2).
 #[test]
 fn a_young_laplace_bridge_holds_two_beads_at_its_own_balance() {
-    let mut sim = two_beads(&pair(
+    let s = wet_pair_at_rest(
         "{ liquid_bridge: { surface_tension_n_per_m: 0.072, viscosity_pa_s: 0.01, capillary_force: young_laplace } }",
-        1.0e-6,
-        ", liquid_content: 0.02",
-    ));
-    sim.particles.velocity_m_per_s[0].x = 0.005;
-    sim.particles.velocity_m_per_s[1].x = -0.005;
-    sim.run_steps(200_000).expect("stable");
-    let s = sim.snapshot();
-    assert_eq!(s.cohesion.pairs.len(), 1, "one bridge");
+    );
     let volume = s.cohesion.pairs[0].2.bridge_volume_m3;
     let table = granflow::engine::models::capillary_table::CapillaryTable::new(0.001, 0.001, 0.0, 0.0);
     let capillary = table.force_n(volume, 0.0, 0.072);
