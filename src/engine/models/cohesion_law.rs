@@ -59,7 +59,7 @@ pub enum CapillaryForce {
     /// Mikami's fit (seed 000 eqs 2.16–2.17) between particles of equal radius with contact angle 0, where it is
     /// settled against the exact bridge (within 5 %, VALIDATION B2); the Young–Laplace table (eqs 6.5–6.28) for
     /// every other pair (unequal radii or contact angles, or θ > 0, where Mikami's θ² term as printed is 15–160 %
-    /// above the exact bridge and with its sign flipped still 12–34 % off).
+    /// above the exact bridge and with its sign flipped still 12–46 % off).
     #[default]
     Auto,
     /// The Young–Laplace table for every pair.
