@@ -307,14 +307,11 @@ fn square_well_pairs_escape_or_are_captured_as_the_energy_balance_says() {
     }
 }
 
-/// A wet bead on a floor, with `walls: true`: a bridge to the wall forms on contact with half the bead's liquid and
-/// the bead rests where the Hertz force balances its weight plus Mikami's force for a plane (R* = R); liquid on the
-/// bead plus the bridge stays what the bead started with. With the default (no wall bridges) nothing forms.
-#[test]
-fn a_wet_bead_bridges_to_the_floor_only_when_wall_bridges_are_on() {
-    let yaml = |walls: bool| {
-        format!(
-            r#"
+/// A wet bead (V̂ = 0.02, θ = 10°) resting on a floor, with or without wall bridges, bridges forming from
+/// `bridges_from_s`.
+fn bead_on_floor(walls: bool, bridges_from_s: f64) -> String {
+    format!(
+        r#"
 name: bead-on-floor
 domain: {{ lo_m: [-0.005, 0.0, -0.005], hi_m: [0.005, 0.01, 0.005] }}
 gravity: {{ vector_m_per_s2: [0.0, -9.81, 0.0] }}
@@ -322,13 +319,43 @@ species:
   - {{ name: s, radius_m: 0.001, density_kg_per_m3: 2500.0, youngs_modulus_pa: 1.0e7, poisson_ratio: 0.3, friction_coefficient: 0.3, contact_angle_deg: 10.0, liquid_content: 0.02 }}
 contact: {{ normal: {{ hertz: {{ restitution: 0.5 }} }}, tangential: mindlin }}
 walls: [ {{ box: {{ species: s }} }} ]
-cohesion: {{ liquid_bridge: {{ surface_tension_n_per_m: 0.072, viscosity_pa_s: 0.01, walls: {walls} }} }}
+cohesion: {{ liquid_bridge: {{ surface_tension_n_per_m: 0.072, viscosity_pa_s: 0.01, walls: {walls}, bridges_from_s: {bridges_from_s} }} }}
 fill:
   - lattice: {{ species: s, spacing_m: 0.004, lo_m: [-0.001, 0.0012, -0.001], hi_m: [0.001, 0.0014, 0.001], origin_m: [0.0, 0.0013, 0.0] }}
 time: {{ dt_s: 1.0e-6, end_time_s: 1.0 }}
 "#
-        )
-    };
+    )
+}
+
+/// With `bridges_from_s` the bead touches the floor dry until then, and the bridge forms in place at that time.
+#[test]
+fn bridges_form_only_from_their_start_time() {
+    let mut sim = simulation(&built(&bead_on_floor(true, 0.1)), 1);
+    sim.run_steps(99_000).expect("stable");
+    let before = sim.snapshot();
+    assert!(before.cohesion.walls.is_empty(), "no bridge before 0.1 s");
+    assert!(
+        (before.particles.liquid_m3[0] / 0.02e-9 - 1.0).abs() < 1e-14,
+        "all the liquid still on the bead"
+    );
+    assert!(
+        before.particles.position_m[0].y < 0.001,
+        "resting on the floor, in contact"
+    );
+    sim.run_steps(2_000).expect("stable");
+    assert_eq!(
+        sim.snapshot().cohesion.walls.len(),
+        1,
+        "the bridge forms at 0.1 s, in place"
+    );
+}
+
+/// A wet bead on a floor, with `walls: true`: a bridge to the wall forms on contact with half the bead's liquid and
+/// the bead rests where the Hertz force balances its weight plus Mikami's force for a plane (R* = R); liquid on the
+/// bead plus the bridge stays what the bead started with. With the default (no wall bridges) nothing forms.
+#[test]
+fn a_wet_bead_bridges_to_the_floor_only_when_wall_bridges_are_on() {
+    let yaml = |walls: bool| bead_on_floor(walls, 0.0);
     let liquid = 0.02e-9;
     let mut dry_walls = simulation(&built(&yaml(false)), 1);
     dry_walls.run_steps(50_000).expect("stable");

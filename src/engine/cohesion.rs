@@ -90,6 +90,12 @@ impl Cohesion {
                         format!("expected a finite value >= 0, got {}", b.viscosity_pa_s),
                     ));
                 }
+                if !(b.bridges_from_s.is_finite() && b.bridges_from_s >= 0.0) {
+                    return Err((
+                        "cohesion.liquid_bridge.bridges_from_s".into(),
+                        format!("expected a time >= 0 s, got {}", b.bridges_from_s),
+                    ));
+                }
                 let min_radius = species.species.iter().map(|s| s.radius_m).fold(f64::INFINITY, f64::min);
                 cohesion.min_gap_m = b.min_gap_m.unwrap_or(0.01 * min_radius);
                 positive("cohesion.liquid_bridge.min_gap_m", cohesion.min_gap_m)?;
@@ -157,7 +163,7 @@ impl Cohesion {
                         let mikami_settled = a.radius_m == b.radius_m && ta == 0.0 && tb == 0.0;
                         cohesion.capillary.push(
                             (!mikami_settled || b_law == CapillaryForce::YoungLaplace)
-                                .then(|| CapillaryTable::new(a.radius_m, b.radius_m, ta, tb)),
+                                .then(|| capillary_table(a.radius_m, b.radius_m, ta, tb)),
                         );
                     }
                 }
@@ -419,6 +425,19 @@ impl AlignedCohesion {
         }
         (out, orphans)
     }
+}
+
+/// The Young–Laplace force table of one species pair, from the disk cache when it holds it (built and cached
+/// otherwise; `capillary_cache.rs`).
+fn capillary_table(radius_1_m: f64, radius_2_m: f64, angle_1_rad: f64, angle_2_rad: f64) -> CapillaryTable {
+    use super::models::capillary_cache::{Provenance, cache_dir, load_or_build};
+    let (table, provenance) = load_or_build(cache_dir().as_deref(), radius_1_m, radius_2_m, angle_1_rad, angle_2_rad);
+    match provenance {
+        Provenance::Loaded(p) => tracing::debug!("Young–Laplace table read from {}", p.display()),
+        Provenance::BuiltAndCached(p) => tracing::info!("Young–Laplace table built and cached in {}", p.display()),
+        Provenance::BuiltOnly(why) => tracing::info!("Young–Laplace table built, not cached: {why}"),
+    }
+    table
 }
 
 /// Liquid on the particles and in the bridges, m³.

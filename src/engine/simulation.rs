@@ -491,6 +491,13 @@ impl Simulation {
             let g = self.config.gravity.at(self.time_s);
             self.sprayed_m3 += spray_surface(&mut self.particles, &g, spray.max_liquid_content);
         }
+        // Before `bridges_from_s` no bridge exists yet, so the pass has nothing to do (and must form none).
+        if let CohesionModel::LiquidBridge(b) = cohesion.model
+            && self.time_s < b.bridges_from_s
+        {
+            self.timers.cohesion += t.elapsed();
+            return;
+        }
         if !self.accumulators_zeroed {
             self.particles.force_n.iter_mut().for_each(|f| *f = Vec3::zeros());
             self.particles.torque_n_m.iter_mut().for_each(|t| *t = Vec3::zeros());

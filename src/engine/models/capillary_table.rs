@@ -9,7 +9,8 @@
 //! stable branch). Lookups interpolate F̂ linearly in ln V̂ within the two rows around Ŝ, then ln F̂ linearly in Ŝ
 //! (the force decays about exponentially with the gap). Past the last row that holds the volume (the bridge's last
 //! pendular profile) that row's force is held: a bridge pulls until it breaks, which it does at Lian's gap
-//! (`cohesion.rs`). Built in parallel when a run starts (about a second per pair of unlike species on two cores).
+//! (`cohesion.rs`). Built in parallel at first use (1–3 s per pair of unlike species on two cores) and cached on disk
+//! (`capillary_cache.rs`).
 
 use super::young_laplace::SpherePair;
 
@@ -115,6 +116,23 @@ impl CapillaryTable {
                 }
                 row
             })
+            .collect();
+        CapillaryTable { radius_1_m, rows }
+    }
+
+    /// The rows as (ln V̂, F̂) columns, for the cache (`capillary_cache.rs`).
+    pub fn rows(&self) -> Vec<(Vec<f64>, Vec<f64>)> {
+        self.rows
+            .iter()
+            .map(|r| (r.ln_volume.clone(), r.force.clone()))
+            .collect()
+    }
+
+    /// A table from rows [`CapillaryTable::rows`] gave, in R₁ = `radius_1_m`.
+    pub fn from_rows(radius_1_m: f64, rows: Vec<(Vec<f64>, Vec<f64>)>) -> Self {
+        let rows = rows
+            .into_iter()
+            .map(|(ln_volume, force)| Row { ln_volume, force })
             .collect();
         CapillaryTable { radius_1_m, rows }
     }

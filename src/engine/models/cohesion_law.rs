@@ -46,6 +46,14 @@ pub struct LiquidBridge {
     /// wall is dry: CHOICE, the film a wall would keep is not tracked).
     #[serde(default, skip_serializing_if = "is_false")]
     pub walls: bool,
+    /// Time from which bridges form, s (default 0). Before it the particles carry their liquid but touch dry, so a
+    /// bed can settle dry and be wetted in place: wet and dry runs of one seed then start from the same packing.
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub bridges_from_s: f64,
+}
+
+fn is_zero(v: &f64) -> bool {
+    *v == 0.0
 }
 
 fn is_false(b: &bool) -> bool {

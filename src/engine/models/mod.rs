@@ -2,6 +2,7 @@
 //! beside them. Cohesion, liquid bridges, drag, heat and mass transfer join here in later issues.
 
 pub mod capillary;
+pub mod capillary_cache;
 pub mod capillary_table;
 pub mod cohesion;
 pub mod cohesion_law;
