@@ -101,6 +101,12 @@ const CASES: &[(&str, &str, &str, &[&str])] = &[
         &["fill[0].lattice.spacing_m", "diameter"],
     ),
     (
+        "lattice jitter wider than half the gap",
+        "spacing_m: 0.0025,",
+        "spacing_m: 0.0025, jitter_m: 0.0003,",
+        &["fill[0].lattice.jitter_m", "overlap"],
+    ),
+    (
         "particles cannot fit",
         "lo_m: [0.001, 0.001, 0.001], hi_m: [0.019, 0.019, 0.02]",
         "lo_m: [0.03, 0.03, 0.03], hi_m: [0.04, 0.04, 0.04]",

@@ -566,6 +566,7 @@ fn fill(
                 hi_m,
                 origin_m,
                 inside_drum,
+                jitter_m,
             } => {
                 let key = |f: &str| format!("fill[{k}].lattice.{f}");
                 let id = c.species(&key("species"), species, s)?;
@@ -586,6 +587,18 @@ fn fill(
                 if let Some(d) = inside_drum {
                     drum_named(c, &key("inside_drum"), walls, d)?;
                 }
+                let jitter_m = *jitter_m;
+                c.non_negative(&key("jitter_m"), jitter_m)?;
+                // (The 1e-9 spacing slack lets "half the gap" be written as a decimal: 0.003 − 0.0027 ≠ 0.0003.)
+                if 2.0 * jitter_m > spacing_m - 2.0 * sp.radius_m + 1e-9 * spacing_m {
+                    return Err(c.fail(
+                        key("jitter_m"),
+                        format!(
+                            "jitter {jitter_m} m could make neighbours overlap: at most half the gap between them, (spacing − diameter)/2 = {} m",
+                            0.5 * (spacing_m - 2.0 * sp.radius_m)
+                        ),
+                    ));
+                }
                 let mut range = [(0i64, 0i64); 3];
                 for a in 0..3 {
                     let first = ((lo_m[a] - origin_m[a]) / spacing_m).ceil() as i64;
@@ -603,13 +616,20 @@ fn fill(
                 for iz in range[2].0..=range[2].1 {
                     for iy in range[1].0..=range[1].1 {
                         for ix in range[0].0..=range[0].1 {
-                            let x = Vec3::new(
+                            let mut x = Vec3::new(
                                 origin_m[0] + ix as f64 * spacing_m,
                                 origin_m[1] + iy as f64 * spacing_m,
                                 origin_m[2] + iz as f64 * spacing_m,
                             );
                             if (0..3).any(|a| x[a] < lo_m[a] || x[a] >= hi_m[a]) {
                                 continue;
+                            }
+                            if jitter_m > 0.0 {
+                                for a in 0..3 {
+                                    if range[a].1 > range[a].0 {
+                                        x[a] += rng.random_range(-jitter_m..=jitter_m);
+                                    }
+                                }
                             }
                             if fits(&x, sp.radius_m, walls, domain) {
                                 particles.push(id, sp, sp.radius_m, x);
@@ -790,4 +810,64 @@ fn random_insert(
         }
     }
     placed
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const JITTERED: &str = r#"
+name: jittered layer
+seed: SEED
+domain: { lo_m: [0.0, 0.0, 0.0], hi_m: [0.03, 0.05, 0.0027], periodic: [true, false, false] }
+pseudo_2d: true
+gravity: { vector_m_per_s2: [0.0, -9.81, 0.0] }
+species:
+  - { name: glass, radius_m: 0.00135, density_kg_per_m3: 2000.0, youngs_modulus_pa: 1.0e7, poisson_ratio: 0.33, friction_coefficient: 0.3 }
+contact: { normal: { hertz: { restitution: 0.9 } }, tangential: mindlin }
+walls:
+  - box: { species: glass }
+fill:
+  - lattice: { species: glass, spacing_m: 0.003, lo_m: [0.0, 0.0015, 0.0], hi_m: [0.03, 0.0315, 0.0027], origin_m: [0.0015, 0.0015, 0.00135], jitter_m: JITTER }
+time: { dt_s: 1.0e-5, end_time_s: 0.001 }
+"#;
+
+    fn positions(seed: u64, jitter_m: f64) -> Vec<Vec3> {
+        let text = JITTERED
+            .replace("SEED", &seed.to_string())
+            .replace("JITTER", &jitter_m.to_string());
+        let path = Path::new("jittered.yaml");
+        let built = build(crate::scenario::parse(&text, path).expect("parses"), path).expect("builds");
+        built.particles.position_m.clone()
+    }
+
+    #[test]
+    fn lattice_jitter_moves_points_in_plane_within_bounds_and_follows_the_seed() {
+        let exact = positions(1, 0.0);
+        let jitter_m = 1.5e-4;
+        let a = positions(1, jitter_m);
+        assert_eq!(exact.len(), 100, "10 x 10 points");
+        assert_eq!(a.len(), exact.len());
+        let mut largest = [0.0f64; 3];
+        for (x, x0) in a.iter().zip(&exact) {
+            for (axis, l) in largest.iter_mut().enumerate() {
+                *l = l.max((x[axis] - x0[axis]).abs());
+            }
+        }
+        assert!(largest[0] <= jitter_m && largest[1] <= jitter_m, "{largest:?}");
+        assert!(
+            largest[0] > 0.8 * jitter_m && largest[1] > 0.8 * jitter_m,
+            "the offsets span the range: {largest:?}"
+        );
+        assert_eq!(largest[2], 0.0, "one point across z: the layer stays in its plane");
+        for (i, x) in a.iter().enumerate() {
+            for y in &a[i + 1..] {
+                let mut d = x - y;
+                d[0] -= 0.03 * (d[0] / 0.03).round();
+                assert!(d.norm() >= 2.0 * 0.00135, "jittered neighbours overlap");
+            }
+        }
+        assert_eq!(a, positions(1, jitter_m), "the same seed gives the same points");
+        assert_ne!(a, positions(2, jitter_m), "another seed gives other points");
+    }
 }

@@ -134,6 +134,11 @@ pub enum FillSpec {
         /// Keep only points whose particle fits inside this drum.
         #[serde(default)]
         inside_drum: Option<String>,
+        /// Displace each point by a uniform random offset in [−jitter_m, jitter_m] (scenario seed) along every
+        /// axis in which the lattice holds more than one point, so that replicates settle into different packings.
+        /// At most half the gap between neighbours: 2·jitter_m ≤ spacing_m − particle diameter.
+        #[serde(default)]
+        jitter_m: f64,
     },
     /// Particles at given positions, optionally with initial velocities and angular velocities.
     Explicit {
