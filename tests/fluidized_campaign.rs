@@ -150,3 +150,45 @@ fn a_gas_cycle_reduces_to_seed_001s_cycle_metrics() {
     assert_eq!(ratios.len(), 2, "{text}");
     assert!(ratios.iter().all(|r| r.is_finite() && *r > 0.0), "{ratios:?}");
 }
+
+/// A bed stepped up through gas levels (`inflow_levels`, 0.1 s each, after 0.1 s of settling) reduces to one u_mf:
+/// the slowest level from which the bed keeps moving. Seed 000's beads (R = 1.35 mm, 2000 kg/m³) fluidize at
+/// 1.45-1.65 m/s in its 40-row bed (D2, D3); this bed of 10 rows is looser at its ends, its packed ΔP reaches W/A
+/// (250 Pa) near 1.7 m/s, and it starts moving there. The levels bracket that onset.
+#[test]
+fn a_bed_stepped_up_through_gas_levels_reduces_to_its_onset_velocity() {
+    let tmp = tempfile::tempdir().expect("temp dir");
+    let dir = tmp.path();
+    let yaml = campaign("[249.0, 250.2]")
+        .replace(
+            "dem_steps_per_gas_step: 5",
+            "dem_steps_per_gas_step: 5\n    inflow_ramp: { start_s: 0.1, duration_s: 0.05 }\n    inflow_levels: { start_s: 0.15, hold_s: 0.1, factors: [0.8, 1.0, 1.2, 1.3, 1.4, 1.5, 1.6, 1.7, 1.8, 2.0, 2.2, 2.4] }",
+        )
+        .replace("values: [0.3, 1.0, 3.0]", "values: [1.0]")
+        .replace("values: [1000.0, 2000.0]", "values: [2000.0]")
+        .replace("end_time_s: 0.003", "end_time_s: 1.35")
+        .replace("series_every_steps: 5", "series_every_steps: 50")
+        .replace(
+            "metrics: [pressure_drop_mean_pa,",
+            "metrics: [stepped_fluidization_velocity_m_per_s, pressure_drop_mean_pa,",
+        );
+    let yaml = yaml[..yaml.find("derived:").unwrap()].to_string() + "executor: { local: { max_parallel: 1 } }\n";
+    std::fs::write(dir.join("steps.yaml"), yaml).unwrap();
+    let out = granflow(&["run", "steps.yaml", "--out", "steps", "--quiet"], dir);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let out = granflow(
+        &[
+            "query",
+            "steps",
+            "--sql",
+            "SELECT value FROM metrics WHERE name = 'stepped_fluidization_velocity_m_per_s'",
+            "--format",
+            "csv",
+        ],
+        dir,
+    );
+    let text = String::from_utf8_lossy(&out.stdout);
+    let onset: f64 = text.lines().nth(1).expect("one value").parse().unwrap();
+    println!("stepped onset: {onset} m/s");
+    assert!((1.5..=2.0).contains(&onset), "{onset}");
+}

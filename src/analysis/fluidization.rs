@@ -4,6 +4,10 @@
 //!   its standard deviation jumps. u_mf is the first velocity above the largest jump of log σ(ΔP) between
 //!   neighbouring velocities of the sweep (so its resolution is the sweep's spacing; the velocity below the jump is
 //!   reported too);
+//! - **sustained fluctuations** (the same signal read as a state): the lowest velocity of the sweep from which σ(ΔP)
+//!   stays above [`MOVING_BED_STD_OVER_WEIGHT`] of W/A at every higher velocity. Near the onset a cohesive bed can
+//!   be bistable (moving at one velocity, packed again at the next); this reading takes the velocity above the last
+//!   return to the packed state, where the largest-jump reading may take an earlier, isolated burst;
 //! - **Ergun line** (seed 001 §7, "theoretical" u_mf): a straight line fitted to the mean ΔP of the packed-bed
 //!   points (those below the jump) meets the bed-weight line W/A.
 
@@ -26,7 +30,14 @@ pub struct MinimumFluidization {
     pub jump_ratio: f64,
     /// Where the line through the packed-bed points meets W/A (NaN with fewer than two packed points).
     pub from_ergun_line_m_per_s: f64,
+    /// The lowest velocity from which the bed keeps moving (σ(ΔP) ≥ 1 % of W/A) at every higher velocity; NaN when
+    /// the sweep does not bracket the onset (its slowest point already moving, or its fastest still packed).
+    pub from_sustained_fluctuations_m_per_s: f64,
 }
+
+/// σ(ΔP) over W/A that tells a moving bed from a packed one. CHOICE: in seed 000's bed (D2, D3) packed beds show
+/// σ ≤ 0.1 % of W/A (the gas solver's noise) and moving beds ≥ 1.5 %; 1 % lies in that gap.
+pub const MOVING_BED_STD_OVER_WEIGHT: f64 = 0.01;
 
 /// u_mf from the sweep points (any order, at least three finite points; `None` otherwise).
 pub fn minimum_fluidization(points: &[SweepPoint]) -> Option<MinimumFluidization> {
@@ -61,7 +72,15 @@ pub fn minimum_fluidization(points: &[SweepPoint]) -> Option<MinimumFluidization
     } else {
         f64::NAN
     };
+    let moving = |q: &SweepPoint| q.pressure_drop_std_pa >= MOVING_BED_STD_OVER_WEIGHT * q.bed_weight_per_area_pa;
+    let still_moving = p.iter().rev().take_while(|q| moving(q)).count();
+    let from_sustained_fluctuations_m_per_s = if still_moving == 0 || still_moving == p.len() {
+        f64::NAN
+    } else {
+        p[p.len() - still_moving].velocity_m_per_s
+    };
     Some(MinimumFluidization {
+        from_sustained_fluctuations_m_per_s,
         from_fluctuations_m_per_s: p[k + 1].velocity_m_per_s,
         below_jump_m_per_s: p[k].velocity_m_per_s,
         jump_ratio: jump.exp(),
@@ -230,6 +249,39 @@ mod tests {
             .map(|l| level(l.velocity_m_per_s, l.pressure_drop_mean_pa.min(1000.0)))
             .collect();
         assert!(cycle_velocities(&flat, 1000.0).incipient_m_per_s.is_nan());
+    }
+
+    #[test]
+    fn a_bistable_onset_is_read_above_the_last_return_to_the_packed_state() {
+        // Seed 000's wet bed at Ca_g = 2 (D3's first run, W/A ≈ 1000 Pa): a burst at 1.45 m/s, packed again at 1.50.
+        let pts = [
+            point(1.40, 1011.0, 0.465),
+            point(1.425, 1009.0, 0.092),
+            point(1.45, 977.0, 15.6),
+            point(1.475, 999.0, 20.7),
+            point(1.50, 959.0, 0.455),
+            point(1.525, 976.0, 34.8),
+            point(1.55, 1001.0, 21.7),
+            point(1.60, 994.0, 83.3),
+        ];
+        let m = minimum_fluidization(&pts).unwrap();
+        assert_eq!(m.from_fluctuations_m_per_s, 1.45, "the largest jump is the first burst");
+        assert_eq!(m.from_sustained_fluctuations_m_per_s, 1.525);
+        // A sweep that never leaves the packed state, or starts already moving, does not bracket the onset.
+        let packed: Vec<SweepPoint> = pts.iter().map(|q| point(q.velocity_m_per_s, 900.0, 0.5)).collect();
+        assert!(
+            minimum_fluidization(&packed)
+                .unwrap()
+                .from_sustained_fluctuations_m_per_s
+                .is_nan()
+        );
+        let moving: Vec<SweepPoint> = pts.iter().map(|q| point(q.velocity_m_per_s, 1000.0, 50.0)).collect();
+        assert!(
+            minimum_fluidization(&moving)
+                .unwrap()
+                .from_sustained_fluctuations_m_per_s
+                .is_nan()
+        );
     }
 
     #[test]

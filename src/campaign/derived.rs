@@ -103,6 +103,11 @@ pub fn compute(specs: &[DerivedSpec], header: &[String], rows: &[Vec<Value>]) ->
                             "m/s",
                         ),
                         ("u_mf_below_jump_m_per_s", get(|m| m.below_jump_m_per_s), "m/s"),
+                        (
+                            "u_mf_sustained_fluctuation_m_per_s",
+                            get(|m| m.from_sustained_fluctuations_m_per_s),
+                            "m/s",
+                        ),
                         ("u_mf_fluctuation_jump_ratio", get(|m| m.jump_ratio), ""),
                         ("u_mf_ergun_line_m_per_s", get(|m| m.from_ergun_line_m_per_s), "m/s"),
                     ] {

@@ -33,6 +33,7 @@ const CYCLE: &[&str] = &[
     "fluidization_velocity_theoretical_m_per_s",
     "incipient_fluidization_velocity_m_per_s",
     "pressure_overshoot_ratio",
+    "stepped_fluidization_velocity_m_per_s",
 ];
 
 /// Needs two species (1 = the first, 2 = the second).
@@ -231,6 +232,13 @@ pub const METRICS: &[MetricInfo] = &[
         name: "pressure_overshoot_ratio",
         unit: "1",
         description: "the largest level-mean pressure drop of the rising branch up to 1.25 U_mf,th (left of the bubbling bed), over W/A (above 1: an overshoot)",
+        needs_mixing: false,
+        needs_gas: true,
+    },
+    MetricInfo {
+        name: "stepped_fluidization_velocity_m_per_s",
+        unit: "m/s",
+        description: "u_mf of a gas.inflow_levels run stepping the gas up: the slowest level of the rising branch from which the bed keeps moving (σ(ΔP) over the second half of each hold ≥ 1 % of W/A) at every faster level; NaN when the levels do not bracket the onset",
         needs_mixing: false,
         needs_gas: true,
     },

@@ -211,6 +211,7 @@ pub fn metrics(job: &JobSpec, built: &BuiltScenario, sim: &Simulation, series: &
                 cycle(built, sim, series).map_or(f64::NAN, |c| c.incipient_m_per_s)
             }
             "pressure_overshoot_ratio" => cycle(built, sim, series).map_or(f64::NAN, |c| c.overshoot_ratio),
+            "stepped_fluidization_velocity_m_per_s" => stepped_onset_m_per_s(built, sim, series),
             other => return Err(Error::External(format!("metric `{other}` has no reducer"))),
         };
         out.push(Metric {
@@ -327,15 +328,21 @@ fn random_mixture_intensity(job: &JobSpec, sim: &Simulation) -> f64 {
     (fraction * (1.0 - fraction) / (job.analysis.mixing_neighbours + 1) as f64).sqrt()
 }
 
-/// Seed 001's cycle velocities from the series: each level of `gas.inflow_levels` is represented by the mean
-/// pressure drop over the second half of its hold (CHOICE: the first half lets the bed respond; seed 001
-/// time-averages each 0.1 s level at "statistical steady state") at the inlet velocity times the level's factor.
-fn cycle(built: &BuiltScenario, sim: &Simulation, series: &Series) -> Option<analysis::fluidization::CycleVelocities> {
+/// One level of `gas.inflow_levels`: its velocity and the pressure drop's mean and standard deviation over the
+/// second half of its hold (CHOICE: the first half lets the bed respond; seed 001 time-averages each 0.1 s level
+/// at "statistical steady state"); the velocity is the inlet velocity times the level's factor (and the ramp's).
+struct LevelStats {
+    velocity_m_per_s: f64,
+    pressure_drop_mean_pa: f64,
+    pressure_drop_std_pa: f64,
+}
+
+fn level_stats(built: &BuiltScenario, sim: &Simulation, series: &Series) -> Option<Vec<LevelStats>> {
     let gas = built.spec.gas.as_ref()?;
     let levels = gas.inflow_levels.as_ref()?;
     let u = inlet_velocity_m_per_s(sim)?;
     let (t, dp) = (series.column("time_s")?, series.column("column_pressure_drop_pa")?);
-    let points: Vec<analysis::fluidization::CycleLevel> = levels
+    let stats = levels
         .factors
         .iter()
         .enumerate()
@@ -351,13 +358,53 @@ fn cycle(built: &BuiltScenario, sim: &Simulation, series: &Series) -> Option<ana
                 .map(|(_, v)| *v)
                 .collect();
             let ramp = gas.inflow_ramp.map_or(1.0, |r| r.factor(from));
-            (!window.is_empty()).then(|| analysis::fluidization::CycleLevel {
+            (!window.is_empty()).then(|| LevelStats {
                 velocity_m_per_s: u * factor * ramp,
                 pressure_drop_mean_pa: mean(&window),
+                pressure_drop_std_pa: std_dev(&window),
             })
         })
         .collect();
+    Some(stats)
+}
+
+/// Seed 001's cycle velocities from the level means ([`level_stats`]).
+fn cycle(built: &BuiltScenario, sim: &Simulation, series: &Series) -> Option<analysis::fluidization::CycleVelocities> {
+    let points: Vec<analysis::fluidization::CycleLevel> = level_stats(built, sim, series)?
+        .iter()
+        .map(|l| analysis::fluidization::CycleLevel {
+            velocity_m_per_s: l.velocity_m_per_s,
+            pressure_drop_mean_pa: l.pressure_drop_mean_pa,
+        })
+        .collect();
     (points.len() >= 3).then(|| analysis::fluidization::cycle_velocities(&points, bed_weight_per_area_pa(built, sim)))
+}
+
+/// u_mf of a run whose levels step the gas up: on the rising branch (from the slowest level on), the slowest level
+/// from which the bed keeps moving at every faster level (σ(ΔP) ≥ 1 % of W/A; `minimum_fluidization`'s sustained
+/// reading, applied to the levels of one run instead of to a sweep of runs). NaN when the levels do not bracket the
+/// onset.
+fn stepped_onset_m_per_s(built: &BuiltScenario, sim: &Simulation, series: &Series) -> f64 {
+    let Some(levels) = level_stats(built, sim, series) else {
+        return f64::NAN;
+    };
+    let slowest = levels
+        .iter()
+        .enumerate()
+        .rev()
+        .min_by(|a, b| a.1.velocity_m_per_s.total_cmp(&b.1.velocity_m_per_s))
+        .map_or(0, |(k, _)| k);
+    let weight = bed_weight_per_area_pa(built, sim);
+    let points: Vec<analysis::fluidization::SweepPoint> = levels[slowest..]
+        .iter()
+        .map(|l| analysis::fluidization::SweepPoint {
+            velocity_m_per_s: l.velocity_m_per_s,
+            pressure_drop_mean_pa: l.pressure_drop_mean_pa,
+            pressure_drop_std_pa: l.pressure_drop_std_pa,
+            bed_weight_per_area_pa: weight,
+        })
+        .collect();
+    analysis::fluidization::minimum_fluidization(&points).map_or(f64::NAN, |m| m.from_sustained_fluctuations_m_per_s)
 }
 
 /// W/A: the particles' weight over the area of the inlet side (seed 000 eq 2.74).
