@@ -471,6 +471,25 @@ const CASES: &[(&str, &str, &str, &[&str])] = &[
         "",
         &["key `metrics[0]`", "`lacey_index` needs `analysis.mixing_species`"],
     ),
+    // What a metric needs from the scenario (the drum has no gas, no liquid and two species).
+    (
+        "gas metric without a gas",
+        "coordination_number]",
+        "coordination_number, pressure_drop_mean_pa]",
+        &["key `metrics[4]`", "`pressure_drop_mean_pa` needs a gas"],
+    ),
+    (
+        "wet metric without liquid bridges",
+        "coordination_number]",
+        "coordination_number, granular_bond_number_22]",
+        &["key `metrics[4]`", "`granular_bond_number_22` needs liquid bridges"],
+    ),
+    (
+        "coating variability without a spray",
+        "coordination_number]",
+        "coordination_number, coating_variability]",
+        &["key `metrics[4]`", "`coating_variability` needs a spray"],
+    ),
     (
         "unknown mixing species",
         "mixing_species: red",

@@ -90,9 +90,9 @@ fn a_fluidized_bed_campaign_stores_gas_metrics_derives_u_mf_and_reports() {
     assert_eq!(values.len(), 6);
     assert!(values.iter().all(|&(_, p)| p > 0.0), "{values:?}");
     assert!(values[0].1 < values[5].1, "ΔP grows with the gas velocity: {values:?}");
-    // One u_mf row per density group, four names each.
+    // One u_mf row per density group, five names each.
     let derived = sql("SELECT group_json, name, value FROM derived ORDER BY group_json, name");
-    assert_eq!(derived.lines().count(), 1 + 2 * 4, "{derived}");
+    assert_eq!(derived.lines().count(), 1 + 2 * 5, "{derived}");
     assert!(derived.contains("density_kg_per_m3") && derived.contains("u_mf_pressure_fluctuation_m_per_s"));
 
     let out = granflow(&["report", "bed", "--out", "report/REPORT.md"], dir);

@@ -10,251 +10,246 @@ pub struct MetricInfo {
     pub name: &'static str,
     pub unit: &'static str,
     pub description: &'static str,
-    /// Needs `analysis.mixing_species` (a binary mixture).
-    pub needs_mixing: bool,
-    /// Needs a gas in the scenario.
-    pub needs_gas: bool,
+    /// What it needs from the campaign and its scenario.
+    pub needs: &'static [Need],
 }
 
-/// Needs a liquid-bridge cohesion model (the scenario's `cohesion: liquid_bridge`).
-const WET: &[&str] = &[
-    "granular_bond_number",
-    "granular_bond_number_22",
-    "granular_bond_number_12",
-    "granular_capillary_number",
-    "granular_capillary_number_22",
-    "granular_capillary_number_12",
-    "wet_phase_mixed",
-];
+/// What a metric needs.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Need {
+    /// `analysis.mixing_species` (which species is A in a binary mixture).
+    MixingSpecies,
+    /// A gas in the scenario.
+    Gas,
+    /// `gas.pressure_probe_height_m`.
+    PressureProbe,
+    /// Liquid-bridge cohesion (`cohesion: liquid_bridge`).
+    LiquidBridges,
+    /// Exactly two species (1 = the first, 2 = the second).
+    TwoSpecies,
+    /// A gas with `inflow_levels` (a cycle, or levels stepping the gas up).
+    InflowLevels,
+    /// A spray (`liquid_bridge.spray`).
+    Spray,
+}
 
-/// Needs a gas with `inflow_levels`.
-const CYCLE: &[&str] = &[
-    "defluidization_velocity_m_per_s",
-    "fluidization_velocity_theoretical_m_per_s",
-    "incipient_fluidization_velocity_m_per_s",
-    "pressure_overshoot_ratio",
-    "stepped_fluidization_velocity_m_per_s",
-];
-
-/// Needs two species (1 = the first, 2 = the second).
-const BINARY: &[&str] = &[
-    "granular_bond_number_22",
-    "granular_bond_number_12",
-    "granular_capillary_number_22",
-    "granular_capillary_number_12",
-    "wet_phase_mixed",
-];
+impl Need {
+    /// Why `job` does not meet this need (`None`: it does). `MixingSpecies` is checked on the campaign
+    /// ([`check`]), where the key lives.
+    fn unmet(self, name: &str, job: &JobSpec) -> Option<String> {
+        let scenario = &job.scenario;
+        let gas = scenario.gas.as_ref();
+        let met = match self {
+            Need::MixingSpecies => true,
+            Need::Gas => gas.is_some(),
+            Need::PressureProbe => gas.is_none_or(|g| g.pressure_probe_height_m.is_some()),
+            Need::LiquidBridges => matches!(scenario.cohesion, Some(CohesionModel::LiquidBridge(_))),
+            Need::TwoSpecies => scenario.species.len() == 2,
+            Need::InflowLevels => gas.is_some_and(|g| g.inflow_levels.is_some()),
+            Need::Spray => matches!(
+                scenario.cohesion,
+                Some(CohesionModel::LiquidBridge(LiquidBridge { spray: Some(_), .. }))
+            ),
+        };
+        (!met).then(|| match self {
+            Need::MixingSpecies => unreachable!("always met here"),
+            Need::Gas => format!("`{name}` needs a gas (a `gas:` section in the scenario)"),
+            Need::PressureProbe => format!("`{name}` needs gas.pressure_probe_height_m"),
+            Need::LiquidBridges => {
+                format!("`{name}` needs liquid bridges (`cohesion: {{ liquid_bridge: ... }}` in the scenario)")
+            }
+            Need::TwoSpecies => format!(
+                "`{name}` needs exactly two species (1 = the first, 2 = the second); the scenario has {}",
+                scenario.species.len()
+            ),
+            Need::InflowLevels => {
+                format!("`{name}` needs a gas with `inflow_levels` (a defluidization/fluidization cycle or steps)")
+            }
+            Need::Spray => format!("`{name}` needs a spray (`cohesion: {{ liquid_bridge: {{ spray: ... }} }}`)"),
+        })
+    }
+}
 
 pub const METRICS: &[MetricInfo] = &[
     MetricInfo {
         name: "kinetic_energy_j",
         unit: "J",
         description: "total (translational + rotational) kinetic energy at the end",
-        needs_mixing: false,
-        needs_gas: false,
+        needs: &[],
     },
     MetricInfo {
         name: "translational_kinetic_energy_j",
         unit: "J",
         description: "translational kinetic energy at the end",
-        needs_mixing: false,
-        needs_gas: false,
+        needs: &[],
     },
     MetricInfo {
         name: "bed_top_m",
         unit: "m",
         description: "highest particle centre along -gravity at the end (bed or column height)",
-        needs_mixing: false,
-        needs_gas: false,
+        needs: &[],
     },
     MetricInfo {
         name: "mean_height_m",
         unit: "m",
         description: "mean particle centre height along -gravity at the end",
-        needs_mixing: false,
-        needs_gas: false,
+        needs: &[],
     },
     MetricInfo {
         name: "coordination_number",
         unit: "1",
         description: "mean particle-particle contacts per particle at the end",
-        needs_mixing: false,
-        needs_gas: false,
+        needs: &[],
     },
     MetricInfo {
         name: "granular_temperature_m2_per_s2",
         unit: "m2/s2",
         description: "granular temperature at the end (seed 000 eq. 3.1)",
-        needs_mixing: false,
-        needs_gas: false,
+        needs: &[],
     },
     MetricInfo {
         name: "intensity_of_segregation",
         unit: "1",
         description: "IS at the end: std. dev. of the local volume fraction of the mixing species (seed 000 eqs 2.77-2.78)",
-        needs_mixing: true,
-        needs_gas: false,
+        needs: &[Need::MixingSpecies],
     },
     MetricInfo {
         name: "lacey_index",
         unit: "1",
         description: "Lacey mixing index at the end (seed 000 eq. 2.80)",
-        needs_mixing: true,
-        needs_gas: false,
+        needs: &[Need::MixingSpecies],
     },
     MetricInfo {
         name: "mixing_rate_constant_per_s",
         unit: "1/s",
         description: "k of an exponential fit to IS(t) (seed 000 §4.1.3)",
-        needs_mixing: true,
-        needs_gas: false,
+        needs: &[Need::MixingSpecies],
     },
     MetricInfo {
         name: "mixing_rate_to_random_per_s",
         unit: "1/s",
         description: "k of IS(t) = IS_R + b exp(-k t) with IS_R = sqrt(P(1-P)/n) the random mixture's IS (n particles per local sample): the approach to a random mixture",
-        needs_mixing: true,
-        needs_gas: false,
+        needs: &[Need::MixingSpecies],
     },
     MetricInfo {
         name: "time_to_90pct_max_lacey_s",
         unit: "s",
         description: "first time the Lacey index reaches 90 % of its maximum (seed 000 Table 1)",
-        needs_mixing: true,
-        needs_gas: false,
+        needs: &[Need::MixingSpecies],
     },
     MetricInfo {
         name: "mean_height_time_avg_m",
         unit: "m",
         description: "mean particle centre height along -gravity, averaged over the series from analysis.average_from_s (seed 002's mean particle height, 5-10 s)",
-        needs_mixing: false,
-        needs_gas: false,
+        needs: &[],
     },
     MetricInfo {
         name: "coordination_number_time_avg",
         unit: "1",
         description: "mean particle-particle contacts per particle, averaged over the series from analysis.average_from_s (seed 002 Fig. 5's bulk coordination number)",
-        needs_mixing: false,
-        needs_gas: false,
+        needs: &[],
     },
     MetricInfo {
         name: "bed_weight_per_area_pa",
         unit: "Pa",
         description: "weight of the particles over the inlet area, W/A (seed 000 eq. 2.74): what the pressure drop of a fluidized bed carries",
-        needs_mixing: false,
-        needs_gas: true,
+        needs: &[Need::Gas],
     },
     MetricInfo {
         name: "pressure_drop_mean_pa",
         unit: "Pa",
         description: "time-averaged pressure drop from the inlet face to the top layer of gas cells, from analysis.average_from_s",
-        needs_mixing: false,
-        needs_gas: true,
+        needs: &[Need::Gas],
     },
     MetricInfo {
         name: "pressure_drop_std_pa",
         unit: "Pa",
         description: "standard deviation of that pressure drop over the same window (its jump marks u_mf, seed 000 §4.1.2)",
-        needs_mixing: false,
-        needs_gas: true,
+        needs: &[Need::Gas],
     },
     MetricInfo {
         name: "granular_bond_number",
         unit: "1",
         description: "Bo_g = F_c,max/W of the first species, F_c,max = 2πRγ cos θ (seed 000 §4.1.1)",
-        needs_mixing: false,
-        needs_gas: false,
+        needs: &[Need::LiquidBridges],
     },
     MetricInfo {
         name: "granular_bond_number_22",
         unit: "1",
         description: "Bo_g of the second species",
-        needs_mixing: false,
-        needs_gas: false,
+        needs: &[Need::LiquidBridges, Need::TwoSpecies],
     },
     MetricInfo {
         name: "granular_bond_number_12",
         unit: "1",
         description: "Bo_g12: the 1-2 pair's F_c,max over the lighter particle's weight (seed 000 §4.2.1)",
-        needs_mixing: false,
-        needs_gas: false,
+        needs: &[Need::LiquidBridges, Need::TwoSpecies],
     },
     MetricInfo {
         name: "granular_capillary_number",
         unit: "1",
         description: "Ca_g = F_c,max/F_d of the first species, Di Felice drag at slip U/ε (seed 000 eq. 4.3; analysis.capillary_number_porosity)",
-        needs_mixing: false,
-        needs_gas: true,
+        needs: &[Need::Gas, Need::LiquidBridges],
     },
     MetricInfo {
         name: "granular_capillary_number_22",
         unit: "1",
         description: "Ca_g of the second species",
-        needs_mixing: false,
-        needs_gas: true,
+        needs: &[Need::Gas, Need::LiquidBridges, Need::TwoSpecies],
     },
     MetricInfo {
         name: "granular_capillary_number_12",
         unit: "1",
         description: "Ca_g12: the pair's F_c,max over the drag of the species with the larger F_d/W (seed 000 eqs. 4.4-4.5)",
-        needs_mixing: false,
-        needs_gas: true,
+        needs: &[Need::Gas, Need::LiquidBridges, Need::TwoSpecies],
     },
     MetricInfo {
         name: "wet_phase_mixed",
         unit: "1",
         description: "seed 000's phase rule on Ca_g11, Ca_g22, Ca_g12: 1 = more mixed than dry (M), 0 = more segregated (S)",
-        needs_mixing: false,
-        needs_gas: true,
+        needs: &[Need::Gas, Need::LiquidBridges, Need::TwoSpecies],
     },
     MetricInfo {
         name: "defluidization_velocity_m_per_s",
         unit: "m/s",
         description: "U_mf,df of a gas.inflow_levels cycle: the line through the falling branch's packed-bed level means meets W/A (seed 001 §6.4.2.1)",
-        needs_mixing: false,
-        needs_gas: true,
+        needs: &[Need::Gas, Need::InflowLevels],
     },
     MetricInfo {
         name: "fluidization_velocity_theoretical_m_per_s",
         unit: "m/s",
         description: "U_mf,th: the same on the rising branch",
-        needs_mixing: false,
-        needs_gas: true,
+        needs: &[Need::Gas, Need::InflowLevels],
     },
     MetricInfo {
         name: "incipient_fluidization_velocity_m_per_s",
         unit: "m/s",
         description: "U_mf,in: the velocity of the rising branch's largest pressure drop up to 1.25 U_mf,th, when it exceeds W/A (the overshoot peak)",
-        needs_mixing: false,
-        needs_gas: true,
+        needs: &[Need::Gas, Need::InflowLevels],
     },
     MetricInfo {
         name: "pressure_overshoot_ratio",
         unit: "1",
         description: "the largest level-mean pressure drop of the rising branch up to 1.25 U_mf,th (left of the bubbling bed), over W/A (above 1: an overshoot)",
-        needs_mixing: false,
-        needs_gas: true,
+        needs: &[Need::Gas, Need::InflowLevels],
     },
     MetricInfo {
         name: "stepped_fluidization_velocity_m_per_s",
         unit: "m/s",
         description: "u_mf of a gas.inflow_levels run stepping the gas up: the slowest level of the rising branch from which the bed keeps moving (σ(ΔP) over the second half of each hold ≥ 1 % of W/A) at every faster level; NaN when the levels do not bracket the onset",
-        needs_mixing: false,
-        needs_gas: true,
+        needs: &[Need::Gas, Need::InflowLevels],
     },
     MetricInfo {
         name: "coating_variability",
         unit: "1",
         description: "CV_m = σ/μ of the liquid each particle received from the spray (seed 000 eq. 6.45)",
-        needs_mixing: false,
-        needs_gas: false,
+        needs: &[Need::Spray],
     },
     MetricInfo {
         name: "probe_pressure_drop_mean_pa",
         unit: "Pa",
         description: "time-averaged pressure drop from the inlet to gas.pressure_probe_height_m",
-        needs_mixing: false,
-        needs_gas: true,
+        needs: &[Need::Gas, Need::PressureProbe],
     },
 ];
 
@@ -281,7 +276,7 @@ pub fn check(spec: &CampaignSpec) -> Result<(), (String, String)> {
         if spec.metrics[..k].contains(name) {
             return Err((format!("metrics[{k}]"), format!("metric `{name}` is listed twice")));
         }
-        if m.needs_mixing && spec.analysis.mixing_species.is_none() {
+        if m.needs.contains(&Need::MixingSpecies) && spec.analysis.mixing_species.is_none() {
             return Err((
                 format!("metrics[{k}]"),
                 format!("`{name}` needs `analysis.mixing_species` (which species is A in the binary mixture)"),
@@ -329,75 +324,14 @@ pub fn check(spec: &CampaignSpec) -> Result<(), (String, String)> {
 
 /// Checks what depends on the resolved scenario (the mixing species must exist in it).
 pub fn check_job(job: &JobSpec) -> Result<(), (String, String)> {
-    if job.scenario.gas.is_none()
-        && let Some((k, name)) = job
-            .metrics
-            .iter()
-            .enumerate()
-            .find(|(_, m)| info(m).is_some_and(|i| i.needs_gas))
-    {
-        return Err((
-            format!("metrics[{k}]"),
-            format!("`{name}` needs a gas (a `gas:` section in the scenario)"),
-        ));
-    }
-    if let Some(p) = job
-        .metrics
-        .iter()
-        .position(|m| m == "probe_pressure_drop_mean_pa")
-        .filter(|_| {
-            job.scenario
-                .gas
-                .as_ref()
-                .is_some_and(|g| g.pressure_probe_height_m.is_none())
-        })
-    {
-        return Err((
-            format!("metrics[{p}]"),
-            "`probe_pressure_drop_mean_pa` needs gas.pressure_probe_height_m".into(),
-        ));
-    }
-    let wet = matches!(job.scenario.cohesion, Some(CohesionModel::LiquidBridge(_)));
     for (k, name) in job.metrics.iter().enumerate() {
-        if WET.contains(&name.as_str()) && !wet {
-            return Err((
-                format!("metrics[{k}]"),
-                format!("`{name}` needs liquid bridges (`cohesion: {{ liquid_bridge: ... }}` in the scenario)"),
-            ));
+        if let Some(message) = info(name)
+            .into_iter()
+            .flat_map(|m| m.needs)
+            .find_map(|need| need.unmet(name, job))
+        {
+            return Err((format!("metrics[{k}]"), message));
         }
-        if BINARY.contains(&name.as_str()) && job.scenario.species.len() != 2 {
-            return Err((
-                format!("metrics[{k}]"),
-                format!(
-                    "`{name}` needs exactly two species (1 = the first, 2 = the second); the scenario has {}",
-                    job.scenario.species.len()
-                ),
-            ));
-        }
-    }
-    let sprayed = matches!(
-        job.scenario.cohesion,
-        Some(CohesionModel::LiquidBridge(LiquidBridge { spray: Some(_), .. }))
-    );
-    let cycled = job.scenario.gas.as_ref().is_some_and(|g| g.inflow_levels.is_some());
-    if let Some(k) = job.metrics.iter().position(|m| CYCLE.contains(&m.as_str()))
-        && !cycled
-    {
-        return Err((
-            format!("metrics[{k}]"),
-            format!(
-                "`{}` needs a gas with `inflow_levels` (a defluidization/fluidization cycle)",
-                job.metrics[k]
-            ),
-        ));
-    }
-    if let Some(k) = job.metrics.iter().position(|m| m == "coating_variability")
-        && !sprayed
-    {
-        return Err((
-            format!("metrics[{k}]"),
-            "`coating_variability` needs a spray (`cohesion: { liquid_bridge: { spray: ... } }`)".into(),
-        ));
     }
     if let Some(eps) = job.analysis.capillary_number_porosity
         && !(eps.is_finite() && eps > 0.0 && eps <= 1.0)
