@@ -39,34 +39,40 @@ impl Need {
     fn unmet(self, name: &str, job: &JobSpec) -> Option<String> {
         let scenario = &job.scenario;
         let gas = scenario.gas.as_ref();
-        let met = match self {
-            Need::MixingSpecies => true,
-            Need::Gas => gas.is_some(),
-            Need::PressureProbe => gas.is_none_or(|g| g.pressure_probe_height_m.is_some()),
-            Need::LiquidBridges => matches!(scenario.cohesion, Some(CohesionModel::LiquidBridge(_))),
-            Need::TwoSpecies => scenario.species.len() == 2,
-            Need::InflowLevels => gas.is_some_and(|g| g.inflow_levels.is_some()),
-            Need::Spray => matches!(
-                scenario.cohesion,
-                Some(CohesionModel::LiquidBridge(LiquidBridge { spray: Some(_), .. }))
+        let unless = |met: bool, message: String| (!met).then_some(message);
+        match self {
+            Need::MixingSpecies => None,
+            Need::Gas => unless(
+                gas.is_some(),
+                format!("`{name}` needs a gas (a `gas:` section in the scenario)"),
             ),
-        };
-        (!met).then(|| match self {
-            Need::MixingSpecies => unreachable!("always met here"),
-            Need::Gas => format!("`{name}` needs a gas (a `gas:` section in the scenario)"),
-            Need::PressureProbe => format!("`{name}` needs gas.pressure_probe_height_m"),
-            Need::LiquidBridges => {
-                format!("`{name}` needs liquid bridges (`cohesion: {{ liquid_bridge: ... }}` in the scenario)")
-            }
-            Need::TwoSpecies => format!(
-                "`{name}` needs exactly two species (1 = the first, 2 = the second); the scenario has {}",
-                scenario.species.len()
+            Need::PressureProbe => unless(
+                gas.is_none_or(|g| g.pressure_probe_height_m.is_some()),
+                format!("`{name}` needs gas.pressure_probe_height_m"),
             ),
-            Need::InflowLevels => {
-                format!("`{name}` needs a gas with `inflow_levels` (a defluidization/fluidization cycle or steps)")
-            }
-            Need::Spray => format!("`{name}` needs a spray (`cohesion: {{ liquid_bridge: {{ spray: ... }} }}`)"),
-        })
+            Need::LiquidBridges => unless(
+                matches!(scenario.cohesion, Some(CohesionModel::LiquidBridge(_))),
+                format!("`{name}` needs liquid bridges (`cohesion: {{ liquid_bridge: ... }}` in the scenario)"),
+            ),
+            Need::TwoSpecies => unless(
+                scenario.species.len() == 2,
+                format!(
+                    "`{name}` needs exactly two species (1 = the first, 2 = the second); the scenario has {}",
+                    scenario.species.len()
+                ),
+            ),
+            Need::InflowLevels => unless(
+                gas.is_some_and(|g| g.inflow_levels.is_some()),
+                format!("`{name}` needs a gas with `inflow_levels` (a defluidization/fluidization cycle or steps)"),
+            ),
+            Need::Spray => unless(
+                matches!(
+                    scenario.cohesion,
+                    Some(CohesionModel::LiquidBridge(LiquidBridge { spray: Some(_), .. }))
+                ),
+                format!("`{name}` needs a spray (`cohesion: {{ liquid_bridge: {{ spray: ... }} }}`)"),
+            ),
+        }
     }
 }
 
