@@ -91,6 +91,9 @@ pub enum Command {
         #[arg(long, value_enum, default_value = "csv")]
         format: Format,
     },
+    /// Recompute the metrics of every finished job with this build's reducers (after a reducer changed), from each
+    /// job's final checkpoint and series; updates result.json, the database and the derived metrics.
+    Reduce { dir: PathBuf },
     /// The validation report (Markdown) of a validation campaign: our numbers next to the source's, a verdict.
     Report {
         dir: PathBuf,
@@ -359,6 +362,11 @@ pub fn run(cli: Cli) -> Result<i32> {
         }
         Command::Export { dir, format } => {
             print!("{}", inspect::export(&dir, format)?);
+            Ok(0)
+        }
+        Command::Reduce { dir } => {
+            let n = crate::orchestrate::dispatcher::reduce_campaign_again(&dir)?;
+            eprintln!("{}: reduced {n} finished job(s) again", dir.display());
             Ok(0)
         }
         Command::Report { dir, out } => {

@@ -416,3 +416,55 @@ fn a_job_over_its_time_limit_is_stopped_and_failed_as_a_timeout() {
     );
     assert!(failed.contains("timeout,2"), "{failed}");
 }
+
+/// `granflow reduce` recomputes every finished job's metrics from its final checkpoint and series: metrics spoiled in
+/// the database and in a result.json come back bit for bit, the finish times stay, and it refuses to run beside a
+/// dispatcher's lock.
+#[test]
+fn reducing_a_finished_campaign_again_recomputes_its_metrics_bit_for_bit() {
+    let tmp = tempfile::tempdir().unwrap();
+    let file = write(tmp.path(), "mini.yaml", &campaign("[20.0, 60.0]", 0.03));
+    let out = tmp.path().join("out");
+    ok(
+        &["run", file.to_str().unwrap(), "--out", out.to_str().unwrap(), "--quiet"],
+        tmp.path(),
+    );
+    // Hex of the bits, so the comparison is exact.
+    let metrics_sql = "SELECT job_id, name, hex(value) FROM metrics ORDER BY job_id, name";
+    let before = sql(&out, metrics_sql);
+    let finished = sql(&out, "SELECT job_id, finished_at FROM jobs ORDER BY job_id");
+    assert_eq!(before.lines().count(), 1 + 16, "{before}");
+
+    let db = rusqlite::Connection::open(out.join("campaign.sqlite")).unwrap();
+    db.execute("UPDATE metrics SET value = -1.0", []).unwrap();
+    drop(db);
+    let some_job = before.lines().nth(1).unwrap().split(',').next().unwrap().to_string();
+    let result_path = out.join("jobs").join(&some_job).join("result.json");
+    let result = std::fs::read_to_string(&result_path).unwrap();
+    let mut spoiled: serde_json::Value = serde_json::from_str(&result).unwrap();
+    for m in spoiled["metrics"].as_array_mut().unwrap() {
+        m["value"] = serde_json::json!(-1.0);
+    }
+    std::fs::write(&result_path, serde_json::to_string_pretty(&spoiled).unwrap()).unwrap();
+
+    let reduced = granflow(&["reduce", out.to_str().unwrap()], tmp.path());
+    assert!(reduced.status.success(), "{}", String::from_utf8_lossy(&reduced.stderr));
+    assert!(String::from_utf8_lossy(&reduced.stderr).contains("reduced 4 finished job(s) again"));
+    assert_eq!(sql(&out, metrics_sql), before, "the metrics come back bit for bit");
+    assert_eq!(
+        sql(&out, "SELECT job_id, finished_at FROM jobs ORDER BY job_id"),
+        finished
+    );
+    assert_eq!(
+        std::fs::read_to_string(&result_path).unwrap(),
+        result,
+        "result.json rewritten the same"
+    );
+
+    // Not beside a dispatcher: the campaign lock is held here.
+    let lock = std::fs::File::create(out.join("campaign.lock")).unwrap();
+    lock.try_lock().unwrap();
+    let refused = granflow(&["reduce", out.to_str().unwrap()], tmp.path());
+    assert!(!refused.status.success());
+    assert!(String::from_utf8_lossy(&refused.stderr).contains("is locked"));
+}

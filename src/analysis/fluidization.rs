@@ -110,8 +110,10 @@ pub struct CycleVelocities {
     pub overshoot_ratio: f64,
 }
 
-/// The packed-bed points of a branch (CHOICE: seed 001 fits "all packed-bed points" without a rule; here those with
-/// a positive velocity and ΔP below 0.8 W/A, clear of the transition) need at least two for a line.
+/// The packed-bed points of a branch (CHOICE: seed 001 fits "all packed-bed points" without a rule; here the run of
+/// levels next to the cycle's slowest level whose ΔP stays below 0.8 W/A, clear of the transition, those with a
+/// positive velocity) need at least two for a line. Only the run next to the slowest level counts: a bubbling level
+/// whose mean ΔP happens to dip below 0.8 W/A at the top of the cycle is not a packed bed.
 const PACKED_FRACTION_OF_WEIGHT: f64 = 0.8;
 
 /// The overshoot region's upper end over U_mf,th.
@@ -126,14 +128,14 @@ pub fn cycle_velocities(levels: &[CycleLevel], bed_weight_per_area_pa: f64) -> C
         .min_by(|a, b| a.1.velocity_m_per_s.total_cmp(&b.1.velocity_m_per_s))
         .map_or(0, |(k, _)| k);
     let (falling, rising) = levels.split_at(slowest);
-    let crossing = |branch: &[CycleLevel]| {
-        let packed: Vec<&CycleLevel> = branch
-            .iter()
-            .filter(|l| {
-                l.velocity_m_per_s > 0.0
-                    && l.pressure_drop_mean_pa.is_finite()
+    // `towards_top`: the branch's levels from the slowest one outwards.
+    let crossing = |towards_top: &mut dyn Iterator<Item = &CycleLevel>| {
+        let packed: Vec<&CycleLevel> = towards_top
+            .take_while(|l| {
+                l.pressure_drop_mean_pa.is_finite()
                     && l.pressure_drop_mean_pa < PACKED_FRACTION_OF_WEIGHT * bed_weight_per_area_pa
             })
+            .filter(|l| l.velocity_m_per_s > 0.0)
             .collect();
         if packed.len() < 2 {
             return f64::NAN;
@@ -148,7 +150,7 @@ pub fn cycle_velocities(levels: &[CycleLevel], bed_weight_per_area_pa: f64) -> C
             f64::NAN
         }
     };
-    let fluidization_theoretical_m_per_s = crossing(rising);
+    let fluidization_theoretical_m_per_s = crossing(&mut rising.iter());
     // Seed 001's overshoot region lies left of the bubbling region; CHOICE: levels up to 1.25 U_mf,th (all of the
     // rising branch when U_mf,th is undefined), so that pressure swings of the bubbling bed at the top of the cycle
     // do not count as an overshoot.
@@ -163,7 +165,7 @@ pub fn cycle_velocities(levels: &[CycleLevel], bed_weight_per_area_pa: f64) -> C
         .max_by(|a, b| a.pressure_drop_mean_pa.total_cmp(&b.pressure_drop_mean_pa));
     let overshoot_ratio = peak.map_or(f64::NAN, |l| l.pressure_drop_mean_pa / bed_weight_per_area_pa);
     CycleVelocities {
-        defluidization_m_per_s: crossing(falling),
+        defluidization_m_per_s: crossing(&mut falling.iter().rev()),
         fluidization_theoretical_m_per_s,
         incipient_m_per_s: match peak {
             Some(l) if overshoot_ratio > 1.0 => l.velocity_m_per_s,
@@ -226,7 +228,8 @@ mod tests {
             velocity_m_per_s: u,
             pressure_drop_mean_pa: dp,
         };
-        let mut levels = vec![level(2.2, 1000.0), level(2.0, 990.0)];
+        // The top level's bubbling bed dips below 0.8 W/A: not a packed-bed point (it is not next to the packed run).
+        let mut levels = vec![level(2.4, 700.0), level(2.2, 1000.0), level(2.0, 990.0)];
         for u in [1.4, 1.0, 0.6, 0.2, 0.0] {
             levels.push(level(u, 500.0 * u));
         }

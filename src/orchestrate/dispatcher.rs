@@ -291,6 +291,12 @@ fn param_value(v: &serde_json::Value) -> ParamValue {
 }
 
 fn ingest(store: &mut Store, job_id: &str, result: &worker::JobResult) -> Result<(), Error> {
+    store_result(store, job_id, result, store::unix_time_s())?;
+    tracing::info!(job = job_id, "result ingested");
+    Ok(())
+}
+
+fn store_result(store: &mut Store, job_id: &str, result: &worker::JobResult, finished_at: f64) -> Result<(), Error> {
     let stored = store::JobResult {
         metrics: result
             .metrics
@@ -305,11 +311,53 @@ fn ingest(store: &mut Store, job_id: &str, result: &worker::JobResult) -> Result
         sim_time_s: result.sim_time_s,
         wall_time_s: result.wall_time_s,
         steps: result.steps,
-        finished_at: store::unix_time_s(),
+        finished_at,
     };
-    store.finish_job(job_id, &stored).map_err(store_err)?;
-    tracing::info!(job = job_id, "result ingested");
-    Ok(())
+    store.finish_job(job_id, &stored).map_err(store_err)
+}
+
+/// `granflow reduce <dir>`: recomputes the metrics of every finished job of the campaign in `dir` with this build's
+/// reducers (`worker::rereduce`), replaces them in the database (the jobs keep their finish times) and recomputes
+/// the derived metrics. Holds the campaign lock, so it cannot run beside a dispatcher. Returns how many jobs.
+pub fn reduce_campaign_again(dir: &Path) -> Result<usize, Error> {
+    let campaign = crate::inspect::load_stored_campaign(dir)?;
+    let lock_path = dir.join("campaign.lock");
+    let lock = File::create(&lock_path).map_err(|e| Error::io("create", &lock_path, e))?;
+    match lock.try_lock() {
+        Ok(()) => {}
+        Err(std::fs::TryLockError::WouldBlock) => {
+            return Err(Error::External(format!(
+                "a dispatcher is running this campaign ({} is locked)",
+                lock_path.display()
+            )));
+        }
+        Err(std::fs::TryLockError::Error(e)) => return Err(Error::io("lock", &lock_path, e)),
+    }
+    let mut store = Store::open(database_path(dir)).map_err(store_err)?;
+    let campaign_id = store
+        .campaign_by_name(&campaign.spec.name)
+        .map_err(store_err)?
+        .ok_or_else(|| {
+            Error::External(format!(
+                "{}: no campaign `{}` in the database",
+                dir.display(),
+                campaign.spec.name
+            ))
+        })?
+        .id;
+    let done: Vec<(String, f64)> = store
+        .job_summaries(campaign_id)
+        .map_err(store_err)?
+        .into_iter()
+        .filter(|j| j.status == JobStatus::Done)
+        .map(|j| (j.job_id, j.finished_at.unwrap_or_else(store::unix_time_s)))
+        .collect();
+    for (job_id, finished_at) in &done {
+        let result = worker::rereduce::reduce_again(&job_dir(dir, job_id))?;
+        store_result(&mut store, job_id, &result, *finished_at)?;
+    }
+    store_derived(&mut store, campaign_id, &campaign.spec.derived)?;
+    Ok(done.len())
 }
 
 struct Settings {

@@ -11,6 +11,7 @@
 //! nothing is corrupted, since every file it writes is written to a temporary name and renamed.
 
 mod reduce;
+pub mod rereduce;
 mod series_h5;
 
 use std::fs::File;
