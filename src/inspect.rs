@@ -37,7 +37,13 @@ pub fn load_stored_campaign(dir: &Path) -> Result<Campaign, Error> {
 fn open(dir: &Path) -> Result<(Store, i64, Campaign), Error> {
     let campaign = load_stored_campaign(dir)?;
     let store = Store::open_read_only(database_path(dir)).map_err(store_err)?;
-    let id = store
+    let id = stored_campaign_id(&store, &campaign, dir)?;
+    Ok((store, id, campaign))
+}
+
+/// The database id of the campaign stored in `dir`.
+pub fn stored_campaign_id(store: &Store, campaign: &Campaign, dir: &Path) -> Result<i64, Error> {
+    Ok(store
         .campaign_by_name(&campaign.spec.name)
         .map_err(store_err)?
         .ok_or_else(|| {
@@ -47,8 +53,7 @@ fn open(dir: &Path) -> Result<(Store, i64, Campaign), Error> {
                 campaign.spec.name
             ))
         })?
-        .id;
-    Ok((store, id, campaign))
+        .id)
 }
 
 /// Whether a dispatcher holds the campaign's lock right now.

@@ -87,18 +87,7 @@ pub fn run_campaign(campaign: &Campaign, source: &Path, out: &Path, opts: &Dispa
     }
 
     std::fs::create_dir_all(out.join("jobs")).map_err(|e| Error::io("create directory", out, e))?;
-    let lock_path = out.join("campaign.lock");
-    let lock = File::create(&lock_path).map_err(|e| Error::io("create", &lock_path, e))?;
-    match lock.try_lock() {
-        Ok(()) => {}
-        Err(std::fs::TryLockError::WouldBlock) => {
-            return Err(Error::External(format!(
-                "another dispatcher is running this campaign ({} is locked)",
-                lock_path.display()
-            )));
-        }
-        Err(std::fs::TryLockError::Error(e)) => return Err(Error::io("lock", &lock_path, e)),
-    }
+    let _lock = lock_campaign(out)?;
     let copy = spec_copy_path(out);
     if std::fs::read_to_string(&copy).ok().as_deref() != Some(campaign.yaml.as_str()) {
         write_atomic(&copy, campaign.yaml.as_bytes())?;
@@ -316,35 +305,29 @@ fn store_result(store: &mut Store, job_id: &str, result: &worker::JobResult, fin
     store.finish_job(job_id, &stored).map_err(store_err)
 }
 
+/// Takes the campaign directory's lock (held while the returned file is open): one dispatcher, or one `reduce`, at a
+/// time.
+fn lock_campaign(dir: &Path) -> Result<File, Error> {
+    let lock_path = dir.join("campaign.lock");
+    let lock = File::create(&lock_path).map_err(|e| Error::io("create", &lock_path, e))?;
+    match lock.try_lock() {
+        Ok(()) => Ok(lock),
+        Err(std::fs::TryLockError::WouldBlock) => Err(Error::External(format!(
+            "another dispatcher is running this campaign ({} is locked)",
+            lock_path.display()
+        ))),
+        Err(std::fs::TryLockError::Error(e)) => Err(Error::io("lock", &lock_path, e)),
+    }
+}
+
 /// `granflow reduce <dir>`: recomputes the metrics of every finished job of the campaign in `dir` with this build's
 /// reducers (`worker::rereduce`), replaces them in the database (the jobs keep their finish times) and recomputes
 /// the derived metrics. Holds the campaign lock, so it cannot run beside a dispatcher. Returns how many jobs.
 pub fn reduce_campaign_again(dir: &Path) -> Result<usize, Error> {
     let campaign = crate::inspect::load_stored_campaign(dir)?;
-    let lock_path = dir.join("campaign.lock");
-    let lock = File::create(&lock_path).map_err(|e| Error::io("create", &lock_path, e))?;
-    match lock.try_lock() {
-        Ok(()) => {}
-        Err(std::fs::TryLockError::WouldBlock) => {
-            return Err(Error::External(format!(
-                "a dispatcher is running this campaign ({} is locked)",
-                lock_path.display()
-            )));
-        }
-        Err(std::fs::TryLockError::Error(e)) => return Err(Error::io("lock", &lock_path, e)),
-    }
+    let _lock = lock_campaign(dir)?;
     let mut store = Store::open(database_path(dir)).map_err(store_err)?;
-    let campaign_id = store
-        .campaign_by_name(&campaign.spec.name)
-        .map_err(store_err)?
-        .ok_or_else(|| {
-            Error::External(format!(
-                "{}: no campaign `{}` in the database",
-                dir.display(),
-                campaign.spec.name
-            ))
-        })?
-        .id;
+    let campaign_id = crate::inspect::stored_campaign_id(&store, &campaign, dir)?;
     let done: Vec<(String, f64)> = store
         .job_summaries(campaign_id)
         .map_err(store_err)?
