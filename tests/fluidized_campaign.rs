@@ -132,22 +132,8 @@ fn a_gas_cycle_reduces_to_seed_001s_cycle_metrics() {
             "metrics: [pressure_overshoot_ratio, defluidization_velocity_m_per_s, pressure_drop_mean_pa,",
         );
     std::fs::write(dir.join("cycle.yaml"), yaml).unwrap();
-    let out = granflow(&["run", "cycle.yaml", "--out", "cycle", "--quiet"], dir);
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
-    let out = granflow(
-        &[
-            "query",
-            "cycle",
-            "--sql",
-            "SELECT value FROM metrics WHERE name = 'pressure_overshoot_ratio'",
-            "--format",
-            "csv",
-        ],
-        dir,
-    );
-    let text = String::from_utf8_lossy(&out.stdout);
-    let ratios: Vec<f64> = text.lines().skip(1).map(|l| l.parse().unwrap()).collect();
-    assert_eq!(ratios.len(), 2, "{text}");
+    let ratios = run_and_read(dir, "cycle", "pressure_overshoot_ratio");
+    assert_eq!(ratios.len(), 2, "{ratios:?}");
     assert!(ratios.iter().all(|r| r.is_finite() && *r > 0.0), "{ratios:?}");
 }
 
@@ -174,21 +160,17 @@ fn a_bed_stepped_up_through_gas_levels_reduces_to_its_onset_velocity() {
         );
     let yaml = yaml[..yaml.find("derived:").unwrap()].to_string() + "executor: { local: { max_parallel: 1 } }\n";
     std::fs::write(dir.join("steps.yaml"), yaml).unwrap();
-    let out = granflow(&["run", "steps.yaml", "--out", "steps", "--quiet"], dir);
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
-    let out = granflow(
-        &[
-            "query",
-            "steps",
-            "--sql",
-            "SELECT value FROM metrics WHERE name = 'stepped_fluidization_velocity_m_per_s'",
-            "--format",
-            "csv",
-        ],
-        dir,
-    );
-    let text = String::from_utf8_lossy(&out.stdout);
-    let onset: f64 = text.lines().nth(1).expect("one value").parse().unwrap();
+    let onset = run_and_read(dir, "steps", "stepped_fluidization_velocity_m_per_s")[0];
     println!("stepped onset: {onset} m/s");
     assert!((1.5..=2.0).contains(&onset), "{onset}");
+}
+
+/// Runs `<name>.yaml` in `dir` into `<name>/` and returns every job's value of `metric`.
+fn run_and_read(dir: &std::path::Path, name: &str, metric: &str) -> Vec<f64> {
+    let out = granflow(&["run", &format!("{name}.yaml"), "--out", name, "--quiet"], dir);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let query = format!("SELECT value FROM metrics WHERE name = '{metric}'");
+    let out = granflow(&["query", name, "--sql", &query, "--format", "csv"], dir);
+    let text = String::from_utf8_lossy(&out.stdout);
+    text.lines().skip(1).map(|l| l.parse().unwrap()).collect()
 }
