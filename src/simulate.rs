@@ -71,9 +71,11 @@ pub fn checkpoint_meta(built: &BuiltScenario) -> CheckpointMeta {
 }
 
 /// Series columns of a run with a gas: the pressure drop from the inlet layer of cells to the far layer and to the
-/// probe height (`nan` without a probe), and how the last gas step converged.
-pub const GAS_SERIES_COLUMNS: &str =
-    ",column_pressure_drop_pa,probe_pressure_drop_pa,gas_outer_iterations,gas_linear_iterations,gas_mass_imbalance";
+/// probe height (`nan` without a probe); seed 001's reading, the pressure at the first node (the inlet layer's
+/// centre) minus the outlet's, with W'/A, the weight of the particles beyond that node over the inlet side's area;
+/// and how the last gas step converged.
+pub const GAS_SERIES_COLUMNS: &str = ",column_pressure_drop_pa,probe_pressure_drop_pa,node_pressure_drop_pa,\
+node_weight_per_area_pa,gas_outer_iterations,gas_linear_iterations,gas_mass_imbalance";
 
 /// The series header of a scenario (before any observer columns).
 pub fn series_header(built: &BuiltScenario) -> String {
@@ -92,10 +94,34 @@ fn gas_columns(sim: &Simulation, probe_height_m: Option<f64>) -> String {
     let probe = probe_height_m
         .and_then(|h| gas.pressure_drop_to_pa(h))
         .unwrap_or(f64::NAN);
+    let node = gas.first_node_pressure_drop_pa().unwrap_or(f64::NAN);
+    let weight = weight_beyond_first_node_per_area_pa(sim).unwrap_or(f64::NAN);
     format!(
-        ",{column:e},{probe:e},{},{},{:e}",
+        ",{column:e},{probe:e},{node:e},{weight:e},{},{},{:e}",
         gas.last.outer_iterations, gas.last.linear_iterations, gas.last.mass_imbalance
     )
+}
+
+/// W'/A (seed 001 notes §4.1): the weight of the particles whose centres lie beyond the first gas node (the centre
+/// of the inlet layer of cells, seen from the inlet) over the inlet side's area, Pa; `None` without a gas inlet.
+fn weight_beyond_first_node_per_area_pa(sim: &Simulation) -> Option<f64> {
+    let gas = sim.gas.as_ref()?;
+    let (axis, node_m, inlet_high) = gas.first_node_plane()?;
+    let grid = &gas.solver.config.grid;
+    let area_m2 = grid.face_area_m2(axis) * (grid.cells() / grid.n[axis]) as f64;
+    let g = sim.config.gravity.at(sim.time_s).norm();
+    let p = &sim.particles;
+    let mass_kg: f64 = (0..p.len())
+        .filter(|&i| {
+            if inlet_high {
+                p.position_m[i][axis] < node_m
+            } else {
+                p.position_m[i][axis] > node_m
+            }
+        })
+        .map(|i| p.mass_kg[i])
+        .sum();
+    Some(mass_kg * g / area_m2)
 }
 
 /// Attaches the scenario's gas to a new or restored simulation (with the checkpointed gas state when restored).

@@ -491,6 +491,12 @@ const CASES: &[(&str, &str, &str, &[&str])] = &[
         &["key `metrics[4]`", "`coating_variability` needs a spray"],
     ),
     (
+        "unknown cycle pressure reading",
+        "analysis: { mixing_species: red }",
+        "analysis: { mixing_species: red, cycle_pressure: first_nod }",
+        &["unknown variant `first_nod`", "`column` or `first_node`"],
+    ),
+    (
         "unknown mixing species",
         "mixing_species: red",
         "mixing_species: green",

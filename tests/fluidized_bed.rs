@@ -141,6 +141,48 @@ fn restart_is_exact(extra: &str) {
     assert!(value("gas_outer_iterations") >= 1.0);
 }
 
+/// Seed 001's pressure reading (notes §4.1) in the series: the first node (the centre of the inlet layer of cells,
+/// here 1/24 of 0.1 m up) to the outlet, and W'/A, the weight of the particles above that node over the bed's
+/// area, recomputed here from the checkpoint written at the same step.
+#[test]
+fn the_series_holds_the_first_node_pressure_drop_and_the_weight_above_that_node() {
+    let tmp = tempfile::tempdir().expect("temp dir");
+    let dir = tmp.path();
+    let text = bed(0.01, "").replace("series_every_steps: 70", "series_every_steps: 50");
+    std::fs::write(dir.join("bed.yaml"), text).unwrap();
+    run_ok(&["simulate", "bed.yaml", "--out", "bed", "--quiet"], dir);
+    let state = final_state(&dir.join("bed"));
+    assert_eq!(state.step, 1000);
+    let series = std::fs::read_to_string(dir.join("bed/series.csv")).unwrap();
+    let header: Vec<&str> = series.lines().next().unwrap().split(',').collect();
+    let last: Vec<&str> = series.lines().last().unwrap().split(',').collect();
+    assert_eq!(last[0], "1000");
+    let value = |name: &str| -> f64 { last[header.iter().position(|h| *h == name).unwrap()].parse().unwrap() };
+    let node_m = 0.5 * 0.1 / 12.0;
+    let p = &state.particles;
+    let above_kg: f64 = (0..p.len())
+        .filter(|&i| p.position_m[i][1] > node_m)
+        .map(|i| p.mass_kg[i])
+        .sum();
+    let expected_pa = above_kg * 9.81 / (0.03 * 0.0027);
+    let whole_pa = p.mass_kg.iter().sum::<f64>() * 9.81 / (0.03 * 0.0027);
+    let weight_pa = value("node_weight_per_area_pa");
+    assert!(
+        (weight_pa - expected_pa).abs() <= 1e-9 * expected_pa,
+        "{weight_pa} against {expected_pa}"
+    );
+    // The bottom layer of beads (centres at 1.5 mm) lies below the node: a tenth of the bed.
+    assert!(
+        weight_pa < 0.95 * whole_pa && weight_pa > 0.8 * whole_pa,
+        "{weight_pa} of {whole_pa}"
+    );
+    let (node_pa, column_pa) = (value("node_pressure_drop_pa"), value("column_pressure_drop_pa"));
+    assert!(
+        node_pa > 0.5 * weight_pa && node_pa < column_pa,
+        "node {node_pa}, column {column_pa}, W'/A {weight_pa}"
+    );
+}
+
 #[test]
 fn bad_gas_input_is_rejected_with_its_key_before_anything_is_written() {
     let cases: &[(&str, &str, &str)] = &[

@@ -131,10 +131,24 @@ fn a_gas_cycle_reduces_to_seed_001s_cycle_metrics() {
             "metrics: [pressure_drop_mean_pa,",
             "metrics: [pressure_overshoot_ratio, defluidization_velocity_m_per_s, pressure_drop_mean_pa,",
         );
-    std::fs::write(dir.join("cycle.yaml"), yaml).unwrap();
+    std::fs::write(dir.join("cycle.yaml"), &yaml).unwrap();
     let ratios = run_and_read(dir, "cycle", "pressure_overshoot_ratio");
     assert_eq!(ratios.len(), 2, "{ratios:?}");
     assert!(ratios.iter().all(|r| r.is_finite() && *r > 0.0), "{ratios:?}");
+    // Seed 001's reading: the first node against W'/A. The same runs (the analysis does not change the physics), so
+    // the same pressures within the node's half-cell: the bottom layer of beads sits below the node, W'/A is 0.9 W/A.
+    let node_yaml = yaml.replace(
+        "analysis: { average_from_s: 0.001 }",
+        "analysis: { average_from_s: 0.001, cycle_pressure: first_node }",
+    );
+    assert_ne!(node_yaml, yaml);
+    std::fs::write(dir.join("node.yaml"), &node_yaml).unwrap();
+    let node_ratios = run_and_read(dir, "node", "pressure_overshoot_ratio");
+    assert_eq!(node_ratios.len(), 2, "{node_ratios:?}");
+    for (column, node) in ratios.iter().zip(&node_ratios) {
+        assert!(node.is_finite() && *node != *column, "column {column}, node {node}");
+        assert!((node / column - 1.0).abs() < 0.3, "column {column}, node {node}");
+    }
 }
 
 /// A bed stepped up through gas levels (`inflow_levels`, 0.1 s each, after 0.1 s of settling) reduces to one u_mf:

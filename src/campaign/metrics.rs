@@ -218,7 +218,7 @@ pub const METRICS: &[MetricInfo] = &[
     MetricInfo {
         name: "defluidization_velocity_m_per_s",
         unit: "m/s",
-        description: "U_mf,df of a gas.inflow_levels cycle: the line through the falling branch's packed-bed level means meets W/A (seed 001 §6.4.2.1)",
+        description: "U_mf,df of a gas.inflow_levels cycle: the line through the falling branch's packed-bed level means meets W/A (seed 001 §6.4.2.1; with analysis.cycle_pressure: first_node, the first node's pressure drop against W'/A)",
         needs: &[Need::Gas, Need::InflowLevels],
     },
     MetricInfo {

@@ -116,6 +116,29 @@ pub struct AnalysisSpec {
     /// start a gas before mixing begins.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub mixing_fit_from_s: Option<f64>,
+    /// Which pressure drop the cycle metrics (`gas.inflow_levels`: U_mf,df, U_mf,th, U_mf,in, the overshoot) read:
+    /// `column` (default), the inlet face to the outlet against W/A of the whole bed; or `first_node`, seed 001's
+    /// reading, the first node (the inlet layer's centre) to the outlet against W'/A, the weight beyond that node
+    /// (notes §4.1).
+    #[serde(default, skip_serializing_if = "CyclePressure::is_column")]
+    pub cycle_pressure: CyclePressure,
+}
+
+/// The pressure drop of the cycle metrics; see [`AnalysisSpec::cycle_pressure`].
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize, schemars::JsonSchema)]
+#[serde(rename_all = "snake_case")]
+pub enum CyclePressure {
+    /// From the inlet face (the first layer of cells extrapolated) to the outlet, against W/A of the whole bed.
+    #[default]
+    Column,
+    /// From the centre of the first layer of cells to the outlet, against W'/A of the particles beyond it.
+    FirstNode,
+}
+
+impl CyclePressure {
+    fn is_column(&self) -> bool {
+        *self == CyclePressure::Column
+    }
 }
 
 fn default_neighbours() -> usize {
@@ -131,6 +154,7 @@ impl Default for AnalysisSpec {
             average_from_s: None,
             capillary_number_porosity: None,
             mixing_fit_from_s: None,
+            cycle_pressure: CyclePressure::Column,
         }
     }
 }

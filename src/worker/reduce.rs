@@ -7,6 +7,7 @@ use serde::{Deserialize, Serialize};
 use crate::analysis;
 use crate::campaign::JobSpec;
 use crate::campaign::metrics::info;
+use crate::campaign::spec::CyclePressure;
 use crate::engine::Simulation;
 use crate::engine::models::cohesion_law::CohesionModel;
 use crate::engine::particles::SpeciesId;
@@ -202,16 +203,16 @@ pub fn metrics(job: &JobSpec, built: &BuiltScenario, sim: &Simulation, series: &
             wet if wet.starts_with("granular_") || wet == "wet_phase_mixed" => wet_number(wet, job, built, sim),
             "coating_variability" => crate::engine::spray::coating_variability(&sim.particles.sprayed_m3),
             "defluidization_velocity_m_per_s" => {
-                cycle(built, sim, series).map_or(f64::NAN, |c| c.defluidization_m_per_s)
+                cycle(job, built, sim, series).map_or(f64::NAN, |c| c.defluidization_m_per_s)
             }
             "fluidization_velocity_theoretical_m_per_s" => {
-                cycle(built, sim, series).map_or(f64::NAN, |c| c.fluidization_theoretical_m_per_s)
+                cycle(job, built, sim, series).map_or(f64::NAN, |c| c.fluidization_theoretical_m_per_s)
             }
             "incipient_fluidization_velocity_m_per_s" => {
-                cycle(built, sim, series).map_or(f64::NAN, |c| c.incipient_m_per_s)
+                cycle(job, built, sim, series).map_or(f64::NAN, |c| c.incipient_m_per_s)
             }
-            "pressure_overshoot_ratio" => cycle(built, sim, series).map_or(f64::NAN, |c| c.overshoot_ratio),
-            "stepped_fluidization_velocity_m_per_s" => stepped_onset_m_per_s(built, sim, series),
+            "pressure_overshoot_ratio" => cycle(job, built, sim, series).map_or(f64::NAN, |c| c.overshoot_ratio),
+            "stepped_fluidization_velocity_m_per_s" => stepped_onset_m_per_s(job, built, sim, series),
             other => return Err(Error::External(format!("metric `{other}` has no reducer"))),
         };
         out.push(Metric {
@@ -331,17 +332,29 @@ fn random_mixture_intensity(job: &JobSpec, sim: &Simulation) -> f64 {
 /// One level of `gas.inflow_levels`: its velocity and the pressure drop's mean and standard deviation over the
 /// second half of its hold (CHOICE: the first half lets the bed respond; seed 001 time-averages each 0.1 s level
 /// at "statistical steady state"); the velocity is the inlet velocity times the level's factor (and the ramp's).
+/// With `analysis.cycle_pressure: first_node` the pressure drop is seed 001's first-node reading and the weight its
+/// W'/A, averaged over the same window (particles cross the node as the bed moves); otherwise the column's pressure
+/// drop against W/A of the whole bed.
 struct LevelStats {
     velocity_m_per_s: f64,
     pressure_drop_mean_pa: f64,
     pressure_drop_std_pa: f64,
+    weight_per_area_pa: f64,
 }
 
-fn level_stats(built: &BuiltScenario, sim: &Simulation, series: &Series) -> Option<Vec<LevelStats>> {
+fn level_stats(job: &JobSpec, built: &BuiltScenario, sim: &Simulation, series: &Series) -> Option<Vec<LevelStats>> {
     let gas = built.spec.gas.as_ref()?;
     let levels = gas.inflow_levels.as_ref()?;
     let u = inlet_velocity_m_per_s(sim)?;
-    let (t, dp) = (series.column("time_s")?, series.column("column_pressure_drop_pa")?);
+    let t = series.column("time_s")?;
+    let (dp, weight) = match job.analysis.cycle_pressure {
+        CyclePressure::Column => (series.column("column_pressure_drop_pa")?, None),
+        CyclePressure::FirstNode => (
+            series.column("node_pressure_drop_pa")?,
+            Some(series.column("node_weight_per_area_pa")?),
+        ),
+    };
+    let whole_bed_pa = bed_weight_per_area_pa(built, sim);
     let stats = levels
         .factors
         .iter()
@@ -351,41 +364,47 @@ fn level_stats(built: &BuiltScenario, sim: &Simulation, series: &Series) -> Opti
                 levels.start_s + (k as f64 + 0.5) * levels.hold_s,
                 levels.start_s + (k as f64 + 1.0) * levels.hold_s,
             );
-            let window: Vec<f64> = t
-                .iter()
-                .zip(dp)
-                .filter(|(t, v)| **t >= from && **t < to && v.is_finite())
-                .map(|(_, v)| *v)
+            let rows: Vec<usize> = (0..t.len())
+                .filter(|&k| t[k] >= from && t[k] < to && dp[k].is_finite())
                 .collect();
+            let window: Vec<f64> = rows.iter().map(|&k| dp[k]).collect();
             let ramp = gas.inflow_ramp.map_or(1.0, |r| r.factor(from));
             (!window.is_empty()).then(|| LevelStats {
                 velocity_m_per_s: u * factor * ramp,
                 pressure_drop_mean_pa: mean(&window),
                 pressure_drop_std_pa: std_dev(&window),
+                weight_per_area_pa: weight
+                    .map_or(whole_bed_pa, |w| mean(&rows.iter().map(|&k| w[k]).collect::<Vec<_>>())),
             })
         })
         .collect();
     Some(stats)
 }
 
-/// Seed 001's cycle velocities from the level means ([`level_stats`]).
-fn cycle(built: &BuiltScenario, sim: &Simulation, series: &Series) -> Option<analysis::fluidization::CycleVelocities> {
-    let points: Vec<analysis::fluidization::CycleLevel> = level_stats(built, sim, series)?
+/// Seed 001's cycle velocities from the level means ([`level_stats`]), each level's pressure drop over its weight
+/// per area (seed 001's ΔP* = ΔP/(W'/A_b)), so that the line meets 1.
+fn cycle(
+    job: &JobSpec,
+    built: &BuiltScenario,
+    sim: &Simulation,
+    series: &Series,
+) -> Option<analysis::fluidization::CycleVelocities> {
+    let points: Vec<analysis::fluidization::CycleLevel> = level_stats(job, built, sim, series)?
         .iter()
         .map(|l| analysis::fluidization::CycleLevel {
             velocity_m_per_s: l.velocity_m_per_s,
-            pressure_drop_mean_pa: l.pressure_drop_mean_pa,
+            pressure_drop_mean_pa: l.pressure_drop_mean_pa / l.weight_per_area_pa,
         })
         .collect();
-    (points.len() >= 3).then(|| analysis::fluidization::cycle_velocities(&points, bed_weight_per_area_pa(built, sim)))
+    (points.len() >= 3).then(|| analysis::fluidization::cycle_velocities(&points, 1.0))
 }
 
 /// u_mf of a run whose levels step the gas up: on the rising branch (from the slowest level on), the slowest level
 /// from which the bed keeps moving at every faster level (σ(ΔP) ≥ 1 % of W/A; `minimum_fluidization`'s sustained
 /// reading, applied to the levels of one run instead of to a sweep of runs). NaN when the levels do not bracket the
 /// onset.
-fn stepped_onset_m_per_s(built: &BuiltScenario, sim: &Simulation, series: &Series) -> f64 {
-    let Some(levels) = level_stats(built, sim, series) else {
+fn stepped_onset_m_per_s(job: &JobSpec, built: &BuiltScenario, sim: &Simulation, series: &Series) -> f64 {
+    let Some(levels) = level_stats(job, built, sim, series) else {
         return f64::NAN;
     };
     let slowest = levels
@@ -394,14 +413,13 @@ fn stepped_onset_m_per_s(built: &BuiltScenario, sim: &Simulation, series: &Serie
         .rev()
         .min_by(|a, b| a.1.velocity_m_per_s.total_cmp(&b.1.velocity_m_per_s))
         .map_or(0, |(k, _)| k);
-    let weight = bed_weight_per_area_pa(built, sim);
     let points: Vec<analysis::fluidization::SweepPoint> = levels[slowest..]
         .iter()
         .map(|l| analysis::fluidization::SweepPoint {
             velocity_m_per_s: l.velocity_m_per_s,
             pressure_drop_mean_pa: l.pressure_drop_mean_pa,
             pressure_drop_std_pa: l.pressure_drop_std_pa,
-            bed_weight_per_area_pa: weight,
+            bed_weight_per_area_pa: l.weight_per_area_pa,
         })
         .collect();
     analysis::fluidization::minimum_fluidization(&points).map_or(f64::NAN, |m| m.from_sustained_fluctuations_m_per_s)

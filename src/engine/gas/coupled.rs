@@ -340,6 +340,31 @@ impl GasCoupling {
         Some(inlet - at(h_m / grid.h_m[axis] - 0.5))
     }
 
+    /// Seed 001's pressure drop (notes §4.1): the pressure at the first computational node, the centre of the layer
+    /// of cells at the inlet, minus that of the layer at the outlet, Pa; `None` without an inlet. Unlike
+    /// [`Self::column_pressure_drop_pa`] it leaves out the inlet half-cell and the particles in it.
+    pub fn first_node_pressure_drop_pa(&self) -> Option<f64> {
+        let (axis, high) = self.inlet_side()?;
+        let n = self.solver.config.grid.n[axis];
+        let (first, last) = if high { (n - 1, 0) } else { (0, n - 1) };
+        Some(self.layer_pressure_pa(axis, first) - self.layer_pressure_pa(axis, last))
+    }
+
+    /// Where the first node lies: the axis normal to the inlet side, the node's coordinate along it, m, and whether
+    /// the inlet is the high side (then "above the node" means a smaller coordinate); `None` without an inlet.
+    pub fn first_node_plane(&self) -> Option<(usize, f64, bool)> {
+        let (axis, high) = self.inlet_side()?;
+        let grid = &self.solver.config.grid;
+        let h = grid.h_m[axis];
+        let lo = grid.origin_m[axis];
+        let node = if high {
+            lo + (grid.n[axis] as f64 - 0.5) * h
+        } else {
+            lo + 0.5 * h
+        };
+        Some((axis, node, high))
+    }
+
     /// Pressure drop across the whole column, from the layer at the inlet to the layer at the far end, Pa.
     pub fn column_pressure_drop_pa(&self) -> Option<f64> {
         let (axis, _) = self.inlet_side()?;
