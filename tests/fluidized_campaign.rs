@@ -135,8 +135,10 @@ fn a_gas_cycle_reduces_to_seed_001s_cycle_metrics() {
     let ratios = run_and_read(dir, "cycle", "pressure_overshoot_ratio");
     assert_eq!(ratios.len(), 2, "{ratios:?}");
     assert!(ratios.iter().all(|r| r.is_finite() && *r > 0.0), "{ratios:?}");
-    // Seed 001's reading: the first node against W'/A. The same runs (the analysis does not change the physics), so
-    // the same pressures within the node's half-cell: the bottom layer of beads sits below the node, W'/A is 0.9 W/A.
+    // Seed 001's reading: the first node against W'/A. The same runs (the analysis does not change the physics):
+    // the bottom row of beads (a tenth of the bed) sits below the node and W'/A is 0.9 W/A, but the node also
+    // leaves out the bottom half-cell of ΔP (4.2 of the bed's 30 mm, 14 % of a uniform packed bed's drop): ΔP* falls
+    // by a few per cent.
     let node_yaml = yaml.replace(
         "analysis: { average_from_s: 0.001 }",
         "analysis: { average_from_s: 0.001, cycle_pressure: first_node }",
@@ -147,7 +149,7 @@ fn a_gas_cycle_reduces_to_seed_001s_cycle_metrics() {
     assert_eq!(node_ratios.len(), 2, "{node_ratios:?}");
     for (column, node) in ratios.iter().zip(&node_ratios) {
         assert!(node.is_finite() && *node != *column, "column {column}, node {node}");
-        assert!((node / column - 1.0).abs() < 0.3, "column {column}, node {node}");
+        assert!(*node < *column && *node > 0.8 * column, "column {column}, node {node}");
     }
 }
 
@@ -179,11 +181,13 @@ fn a_bed_stepped_up_through_gas_levels_reduces_to_its_onset_velocity() {
     assert!((1.5..=2.0).contains(&onset), "{onset}");
 }
 
-/// Runs `<name>.yaml` in `dir` into `<name>/` and returns every job's value of `metric`.
+/// Runs `<name>.yaml` in `dir` into `<name>/` and returns every job's value of `metric`, in sweep order.
 fn run_and_read(dir: &std::path::Path, name: &str, metric: &str) -> Vec<f64> {
     let out = granflow(&["run", &format!("{name}.yaml"), "--out", name, "--quiet"], dir);
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
-    let query = format!("SELECT value FROM metrics WHERE name = '{metric}'");
+    let query = format!(
+        "SELECT m.value FROM metrics m JOIN jobs j USING (job_id) WHERE m.name = '{metric}' ORDER BY j.ordinal"
+    );
     let out = granflow(&["query", name, "--sql", &query, "--format", "csv"], dir);
     let text = String::from_utf8_lossy(&out.stdout);
     text.lines().skip(1).map(|l| l.parse().unwrap()).collect()

@@ -103,10 +103,10 @@ pub struct CycleVelocities {
     pub defluidization_m_per_s: f64,
     /// U_mf,th: the same on the rising branch.
     pub fluidization_theoretical_m_per_s: f64,
-    /// U_mf,in: the velocity of the largest pressure drop on the rising branch up to 1.25 U_mf,th, if it exceeds
-    /// W/A (the overshoot peak); NaN without an overshoot.
+    /// U_mf,in: the velocity of the overshoot peak (the largest pressure drop of the rising branch before the bed
+    /// gives way), if it exceeds W/A; NaN without an overshoot.
     pub incipient_m_per_s: f64,
-    /// The largest pressure drop on the rising branch up to 1.25 U_mf,th over W/A (above 1: an overshoot).
+    /// The overshoot peak's pressure drop over W/A (above 1: an overshoot).
     pub overshoot_ratio: f64,
 }
 
@@ -115,9 +115,6 @@ pub struct CycleVelocities {
 /// positive velocity) need at least two for a line. Only the run next to the slowest level counts: a bubbling level
 /// whose mean ΔP happens to dip below 0.8 W/A at the top of the cycle is not a packed bed.
 const PACKED_FRACTION_OF_WEIGHT: f64 = 0.8;
-
-/// The overshoot region's upper end over U_mf,th.
-const OVERSHOOT_REGION_OVER_UMF: f64 = 1.25;
 
 /// U_mf,df, U_mf,th, U_mf,in and the overshoot from the levels of one cycle in time order. The falling branch runs
 /// from the start to the first slowest level, the rising branch from there on.
@@ -151,18 +148,19 @@ pub fn cycle_velocities(levels: &[CycleLevel], bed_weight_per_area_pa: f64) -> C
         }
     };
     let fluidization_theoretical_m_per_s = crossing(&mut rising.iter());
-    // Seed 001's overshoot region lies left of the bubbling region; CHOICE: levels up to 1.25 U_mf,th (all of the
-    // rising branch when U_mf,th is undefined), so that pressure swings of the bubbling bed at the top of the cycle
-    // do not count as an overshoot.
-    let reach = if fluidization_theoretical_m_per_s.is_finite() {
-        OVERSHOOT_REGION_OVER_UMF * fluidization_theoretical_m_per_s
-    } else {
-        f64::INFINITY
-    };
-    let peak = rising
-        .iter()
-        .filter(|l| l.pressure_drop_mean_pa.is_finite() && l.velocity_m_per_s <= reach)
-        .max_by(|a, b| a.pressure_drop_mean_pa.total_cmp(&b.pressure_drop_mean_pa));
+    // Seed 001's overshoot region: the points above W'/A "left of the bubbling region" (notes §4.1). CHOICE: the
+    // bubbling region starts at the first level whose mean pressure drop falls below the previous level's, where
+    // the bed has given way; the peak is the last level of the climb before it. Level means of a bubbling bed
+    // swing by up to 10 % from one level to the next (D8's 0.1 s levels, averaged over 0.05 s), so a window reaching into it
+    // would count bubbles as an overshoot.
+    let mut climb = rising.iter().take_while(|l| l.pressure_drop_mean_pa.is_finite());
+    let mut peak = climb.next();
+    for l in climb {
+        match peak {
+            Some(p) if l.pressure_drop_mean_pa < p.pressure_drop_mean_pa => break,
+            _ => peak = Some(l),
+        }
+    }
     let overshoot_ratio = peak.map_or(f64::NAN, |l| l.pressure_drop_mean_pa / bed_weight_per_area_pa);
     CycleVelocities {
         defluidization_m_per_s: crossing(&mut falling.iter().rev()),
@@ -236,7 +234,8 @@ mod tests {
         for u in [0.2, 0.6, 1.0, 1.2] {
             levels.push(level(u, 600.0 * u));
         }
-        // A bubbling swing at 2.2 m/s (beyond 1.25 U_mf,th = 2.08) is not an overshoot.
+        // The climb peaks at 1.8 m/s and the bed gives way; the bubbling swing at 2.2 m/s after it is not an
+        // overshoot.
         levels.extend([level(1.8, 1150.0), level(2.0, 1005.0), level(2.2, 1200.0)]);
         let c = cycle_velocities(&levels, 1000.0);
         assert!((c.defluidization_m_per_s - 2.0).abs() < 1e-12, "{c:?}");
@@ -252,6 +251,18 @@ mod tests {
             .map(|l| level(l.velocity_m_per_s, l.pressure_drop_mean_pa.min(1000.0)))
             .collect();
         assert!(cycle_velocities(&flat, 1000.0).incipient_m_per_s.is_nan());
+        // A dry bed's climb levels off below W/A and the bed gives way; bubbles then swing the level means above
+        // W/A: no overshoot, the peak is the climb's top.
+        let mut dry = levels[..levels.len() - 3].to_vec();
+        dry.extend([
+            level(1.6, 985.0),
+            level(1.8, 980.0),
+            level(2.0, 1050.0),
+            level(2.2, 940.0),
+        ]);
+        let c = cycle_velocities(&dry, 1000.0);
+        assert!((c.overshoot_ratio - 0.985).abs() < 1e-12, "{c:?}");
+        assert!(c.incipient_m_per_s.is_nan());
     }
 
     #[test]

@@ -230,13 +230,13 @@ pub const METRICS: &[MetricInfo] = &[
     MetricInfo {
         name: "incipient_fluidization_velocity_m_per_s",
         unit: "m/s",
-        description: "U_mf,in: the velocity of the rising branch's largest pressure drop up to 1.25 U_mf,th, when it exceeds W/A (the overshoot peak)",
+        description: "U_mf,in: the velocity of the overshoot peak, the rising branch's largest level-mean pressure drop before the first level whose mean falls (the bed gives way; seed 001: left of the bubbling region), when it exceeds W/A",
         needs: &[Need::Gas, Need::InflowLevels],
     },
     MetricInfo {
         name: "pressure_overshoot_ratio",
         unit: "1",
-        description: "the largest level-mean pressure drop of the rising branch up to 1.25 U_mf,th (left of the bubbling bed), over W/A (above 1: an overshoot)",
+        description: "the overshoot peak (see incipient_fluidization_velocity_m_per_s) over W/A (above 1: an overshoot)",
         needs: &[Need::Gas, Need::InflowLevels],
     },
     MetricInfo {
