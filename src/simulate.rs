@@ -107,8 +107,7 @@ fn gas_columns(sim: &Simulation, probe_height_m: Option<f64>) -> String {
 fn weight_beyond_first_node_per_area_pa(sim: &Simulation) -> Option<f64> {
     let gas = sim.gas.as_ref()?;
     let (axis, node_m, inlet_high) = gas.first_node_plane()?;
-    let grid = &gas.solver.config.grid;
-    let area_m2 = grid.face_area_m2(axis) * (grid.cells() / grid.n[axis]) as f64;
+    let area_m2 = gas.inlet_side_area_m2()?;
     let g = sim.config.gravity.at(sim.time_s).norm();
     let p = &sim.particles;
     let mass_kg: f64 = (0..p.len())

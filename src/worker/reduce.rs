@@ -427,17 +427,12 @@ fn stepped_onset_m_per_s(job: &JobSpec, built: &BuiltScenario, sim: &Simulation,
 
 /// W/A: the particles' weight over the area of the inlet side (seed 000 eq 2.74).
 fn bed_weight_per_area_pa(built: &BuiltScenario, sim: &Simulation) -> f64 {
-    let Some(gas) = sim.gas.as_ref() else {
-        return f64::NAN;
-    };
-    let Some((axis, _)) = gas.inlet_side() else {
+    let Some(area_m2) = sim.gas.as_ref().and_then(|gas| gas.inlet_side_area_m2()) else {
         return f64::NAN;
     };
     let g = built.spec.gravity.vector_m_per_s2;
     let g = (g[0] * g[0] + g[1] * g[1] + g[2] * g[2]).sqrt();
-    let grid = &gas.solver.config.grid;
-    let area = grid.face_area_m2(axis) * (grid.cells() / grid.n[axis]) as f64;
-    sim.particles.mass_kg.iter().sum::<f64>() * g / area
+    sim.particles.mass_kg.iter().sum::<f64>() * g / area_m2
 }
 
 /// Granular temperature (seed 000 eq 3.1) about the mean velocity of layers normal to gravity, each two particle

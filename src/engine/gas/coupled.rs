@@ -350,6 +350,13 @@ impl GasCoupling {
         Some(self.layer_pressure_pa(axis, first) - self.layer_pressure_pa(axis, last))
     }
 
+    /// The area of the inlet side (all its faces, blocked or not), m²; `None` without an inlet.
+    pub fn inlet_side_area_m2(&self) -> Option<f64> {
+        let (axis, _) = self.inlet_side()?;
+        let grid = &self.solver.config.grid;
+        Some(grid.face_area_m2(axis) * (grid.cells() / grid.n[axis]) as f64)
+    }
+
     /// Where the first node lies: the axis normal to the inlet side, the node's coordinate along it, m, and whether
     /// the inlet is the high side (then "above the node" means a smaller coordinate); `None` without an inlet.
     pub fn first_node_plane(&self) -> Option<(usize, f64, bool)> {
