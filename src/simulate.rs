@@ -168,6 +168,24 @@ fn series_row(sim: &Simulation, built: &BuiltScenario) -> String {
     )
 }
 
+/// Refuses to resume into a series file whose columns differ from this run's (written by another granflow
+/// version): its rows would not fit the header, and dropping them would lose finished work silently.
+fn check_series_header(path: &Path, header: &str) -> Result<()> {
+    let text = match std::fs::read_to_string(path) {
+        Ok(t) => t,
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(()),
+        Err(e) => return Err(Error::io("read", path, e)),
+    };
+    match text.lines().next() {
+        Some(existing) if existing != header => Err(Error::External(format!(
+            "{} has the columns `{existing}`, but this granflow writes `{header}` (was the run started by another \
+             version?); finish it with that version or start it again in a new directory",
+            path.display()
+        ))),
+        _ => Ok(()),
+    }
+}
+
 /// Keeps the header and the rows up to `step` of an existing series file.
 fn truncate_series(path: &Path, header: &str, step: u64) -> Result<()> {
     let text = match std::fs::read_to_string(path) {
@@ -314,6 +332,7 @@ pub fn run_in_dir(built: &BuiltScenario, out: &Path, ctl: RunControl) -> Result<
                 )));
             }
             let step = loaded.state.step;
+            check_series_header(&series_path, &header)?;
             truncate_series(&series_path, &header, step)?;
             if !quiet {
                 eprintln!("resuming from {} (step {step})", loaded.path.display());

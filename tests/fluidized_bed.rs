@@ -183,6 +183,45 @@ fn the_series_holds_the_first_node_pressure_drop_and_the_weight_above_that_node(
     );
 }
 
+/// A run interrupted by one granflow and resumed by another that writes other series columns is refused with the
+/// file named, and its series is left as it was (not cut down to the rows that fit the new header).
+#[test]
+fn resuming_a_series_with_other_columns_is_refused_and_the_series_kept() {
+    let tmp = tempfile::tempdir().expect("temp dir");
+    let dir = tmp.path();
+    std::fs::write(dir.join("bed.yaml"), bed(0.01, "")).unwrap();
+    run_ok(
+        &["simulate", "bed.yaml", "--out", "bed", "--max-steps", "500", "--quiet"],
+        dir,
+    );
+    // What an older version wrote: the series without the two first-node columns.
+    let path = dir.join("bed/series.csv");
+    let text = std::fs::read_to_string(&path).unwrap();
+    let header: Vec<&str> = text.lines().next().unwrap().split(',').collect();
+    let drop: Vec<usize> = ["node_pressure_drop_pa", "node_weight_per_area_pa"]
+        .iter()
+        .map(|c| header.iter().position(|h| h == c).expect("column"))
+        .collect();
+    let older: String = text
+        .lines()
+        .map(|l| {
+            let kept: Vec<&str> = l
+                .split(',')
+                .enumerate()
+                .filter(|(k, _)| !drop.contains(k))
+                .map(|(_, f)| f)
+                .collect();
+            kept.join(",") + "\n"
+        })
+        .collect();
+    std::fs::write(&path, &older).unwrap();
+    let out = granflow(&["simulate", "bed.yaml", "--out", "bed", "--quiet"], dir);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success(), "{err}");
+    assert!(err.contains("series.csv has the columns"), "{err}");
+    assert_eq!(std::fs::read_to_string(&path).unwrap(), older, "the series was changed");
+}
+
 #[test]
 fn bad_gas_input_is_rejected_with_its_key_before_anything_is_written() {
     let cases: &[(&str, &str, &str)] = &[
