@@ -168,31 +168,22 @@ fn series_row(sim: &Simulation, built: &BuiltScenario) -> String {
     )
 }
 
-/// Refuses to resume into a series file whose columns differ from this run's (written by another granflow
-/// version): its rows would not fit the header, and dropping them would lose finished work silently.
-fn check_series_header(path: &Path, header: &str) -> Result<()> {
-    let text = match std::fs::read_to_string(path) {
-        Ok(t) => t,
-        Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(()),
-        Err(e) => return Err(Error::io("read", path, e)),
-    };
-    match text.lines().next() {
-        Some(existing) if existing != header => Err(Error::External(format!(
-            "{} has the columns `{existing}`, but this granflow writes `{header}` (was the run started by another \
-             version?); finish it with that version or start it again in a new directory",
-            path.display()
-        ))),
-        _ => Ok(()),
-    }
-}
-
-/// Keeps the header and the rows up to `step` of an existing series file.
-fn truncate_series(path: &Path, header: &str, step: u64) -> Result<()> {
+/// Keeps the header and the rows up to `step` of an existing series file. When `resuming`, a file whose header
+/// differs from `header` (written by another granflow version) is refused and left as it is: its rows would not fit
+/// the header, and dropping them would lose finished work silently.
+fn truncate_series(path: &Path, header: &str, step: u64, resuming: bool) -> Result<()> {
     let text = match std::fs::read_to_string(path) {
         Ok(t) => t,
         Err(e) if e.kind() == std::io::ErrorKind::NotFound => String::new(),
         Err(e) => return Err(Error::io("read", path, e)),
     };
+    if let Some(existing) = text.lines().next().filter(|h| resuming && *h != header) {
+        return Err(Error::External(format!(
+            "{} has the columns `{existing}`, but this granflow writes `{header}` (was the run started by another \
+             version?); finish it with that version or start it again in a new directory",
+            path.display()
+        )));
+    }
     let mut out = String::from(header);
     out.push('\n');
     let fields = header.split(',').count();
@@ -332,8 +323,7 @@ pub fn run_in_dir(built: &BuiltScenario, out: &Path, ctl: RunControl) -> Result<
                 )));
             }
             let step = loaded.state.step;
-            check_series_header(&series_path, &header)?;
-            truncate_series(&series_path, &header, step)?;
+            truncate_series(&series_path, &header, step, true)?;
             if !quiet {
                 eprintln!("resuming from {} (step {step})", loaded.path.display());
             }
@@ -358,7 +348,7 @@ pub fn run_in_dir(built: &BuiltScenario, out: &Path, ctl: RunControl) -> Result<
                 threads,
             )?;
             attach_gas(built, &mut sim, None)?;
-            truncate_series(&series_path, &header, 0)?;
+            truncate_series(&series_path, &header, 0, false)?;
             let row = format!("{}{}", series_row(&sim, built), observer.extra_row(&sim));
             let mut f = std::fs::OpenOptions::new()
                 .append(true)

@@ -54,6 +54,26 @@ fn final_gas(dir: &Path, name: &str, text: &str) -> GasSnapshot {
     final_state(&dir.join(name)).gas.expect("the checkpoint holds the gas")
 }
 
+/// The value of column `name` in the last row of series text `series`.
+fn last_row_value(series: &str, name: &str) -> f64 {
+    let k = series
+        .lines()
+        .next()
+        .unwrap()
+        .split(',')
+        .position(|h| h == name)
+        .unwrap_or_else(|| panic!("column {name}"));
+    series
+        .lines()
+        .last()
+        .unwrap()
+        .split(',')
+        .nth(k)
+        .unwrap()
+        .parse()
+        .unwrap()
+}
+
 fn run_ok(args: &[&str], cwd: &Path) -> String {
     let out = granflow(args, cwd);
     assert!(
@@ -126,14 +146,7 @@ fn restart_is_exact(extra: &str) {
     assert_eq!(a, b, "the series of the restarted run differs");
     // The gas moved and the bed felt it: a pressure drop across the bed, gas faster than the inflow inside it.
     let last = a.lines().last().unwrap();
-    let header: Vec<&str> = a.lines().next().unwrap().split(',').collect();
-    let value = |name: &str| -> f64 {
-        let k = header
-            .iter()
-            .position(|h| *h == name)
-            .unwrap_or_else(|| panic!("column {name}"));
-        last.split(',').nth(k).unwrap().parse().unwrap()
-    };
+    let value = |name: &str| last_row_value(&a, name);
     assert!(value("column_pressure_drop_pa") > 100.0, "{last}");
     assert!(
         value("probe_pressure_drop_pa") > 0.0 && value("probe_pressure_drop_pa") < value("column_pressure_drop_pa")
@@ -154,10 +167,8 @@ fn the_series_holds_the_first_node_pressure_drop_and_the_weight_above_that_node(
     let state = final_state(&dir.join("bed"));
     assert_eq!(state.step, 1000);
     let series = std::fs::read_to_string(dir.join("bed/series.csv")).unwrap();
-    let header: Vec<&str> = series.lines().next().unwrap().split(',').collect();
-    let last: Vec<&str> = series.lines().last().unwrap().split(',').collect();
-    assert_eq!(last[0], "1000");
-    let value = |name: &str| -> f64 { last[header.iter().position(|h| *h == name).unwrap()].parse().unwrap() };
+    let value = |name: &str| last_row_value(&series, name);
+    assert_eq!(value("step"), 1000.0);
     let node_m = 0.5 * 0.1 / 12.0;
     let p = &state.particles;
     let above_kg: f64 = (0..p.len())
@@ -376,17 +387,7 @@ fn a_three_dimensional_bed_runs_with_a_three_dimensional_gas() {
         "the z velocity is solved in 3-D"
     );
     let series = std::fs::read_to_string(dir.join("bed3d/series.csv")).unwrap();
-    let header: Vec<&str> = series.lines().next().unwrap().split(',').collect();
-    let k = header.iter().position(|h| *h == "column_pressure_drop_pa").unwrap();
-    let dp: f64 = series
-        .lines()
-        .last()
-        .unwrap()
-        .split(',')
-        .nth(k)
-        .unwrap()
-        .parse()
-        .unwrap();
+    let dp = last_row_value(&series, "column_pressure_drop_pa");
     assert!(dp > 100.0, "pressure drop across the 3-D bed: {dp}");
 }
 
