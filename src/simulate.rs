@@ -79,11 +79,46 @@ node_weight_per_area_pa,gas_outer_iterations,gas_linear_iterations,gas_mass_imba
 
 /// The series header of a scenario (before any observer columns).
 pub fn series_header(built: &BuiltScenario) -> String {
+    let mut header = SERIES_HEADER.to_string();
     if built.gas.is_some() {
-        format!("{SERIES_HEADER}{GAS_SERIES_COLUMNS}")
-    } else {
-        SERIES_HEADER.to_string()
+        header.push_str(GAS_SERIES_COLUMNS);
     }
+    if built.spec.output.net_forces {
+        header.push_str(",weight_n,fluid_force_up_n");
+        for wall in &built.config.walls {
+            header.push_str(&format!(",wall_{0}_contact_up_n,wall_{0}_cohesion_up_n", wall.name));
+        }
+    }
+    header
+}
+
+/// The net-force columns (`output.net_forces`): the weight, and the components against gravity of the gas's force
+/// and of each wall's contact and cohesion forces on all particles, averaged over the steps since the previous
+/// reading (`nan` before any step). Reading restarts the sums.
+fn net_force_columns(sim: &mut Simulation, built: &BuiltScenario) -> String {
+    if !built.spec.output.net_forces {
+        return String::new();
+    }
+    let g = sim.config.gravity.at(sim.time_s);
+    let weight_n = sim.particles.mass_kg.iter().sum::<f64>() * g.norm();
+    let means = sim.net_force.as_mut().and_then(|t| t.take_means());
+    let walls = sim.config.walls.len();
+    let (fluid, per_wall): (f64, Vec<(f64, f64)>) = match (means, (-g).try_normalize(0.0)) {
+        (Some(m), Some(up)) => (
+            m.fluid_n.dot(&up),
+            m.wall_contact_n
+                .iter()
+                .zip(&m.wall_cohesion_n)
+                .map(|(c, h)| (c.dot(&up), h.dot(&up)))
+                .collect(),
+        ),
+        _ => (f64::NAN, vec![(f64::NAN, f64::NAN); walls]),
+    };
+    let mut out = format!(",{weight_n:e},{fluid:e}");
+    for (contact, cohesion) in per_wall {
+        out.push_str(&format!(",{contact:e},{cohesion:e}"));
+    }
+    out
 }
 
 fn gas_columns(sim: &Simulation, probe_height_m: Option<f64>) -> String {
@@ -149,13 +184,14 @@ pub fn attach_gas(
     }
 }
 
-fn series_row(sim: &Simulation, built: &BuiltScenario) -> String {
+fn series_row(sim: &mut Simulation, built: &BuiltScenario) -> String {
+    let net = net_force_columns(sim, built);
     let (top, mean) = sim.bed_height_m();
     let (pairs, walls) = sim.contact_counts();
     let n = sim.particles.len().max(1) as f64;
     let gas = gas_columns(sim, built.gas.as_ref().and_then(|g| g.pressure_probe_height_m));
     format!(
-        "{},{:e},{:e},{:e},{:e},{:e},{},{},{:.6}{gas}",
+        "{},{:e},{:e},{:e},{:e},{:e},{},{},{:.6}{gas}{net}",
         sim.step,
         sim.time_s,
         sim.particles.kinetic_energy_j(),
@@ -348,8 +384,11 @@ pub fn run_in_dir(built: &BuiltScenario, out: &Path, ctl: RunControl) -> Result<
                 threads,
             )?;
             attach_gas(built, &mut sim, None)?;
+            if built.spec.output.net_forces {
+                sim.record_net_forces();
+            }
             truncate_series(&series_path, &header, 0, false)?;
-            let row = format!("{}{}", series_row(&sim, built), observer.extra_row(&sim));
+            let row = format!("{}{}", series_row(&mut sim, built), observer.extra_row(&sim));
             let mut f = std::fs::OpenOptions::new()
                 .append(true)
                 .open(&series_path)
@@ -361,6 +400,9 @@ pub fn run_in_dir(built: &BuiltScenario, out: &Path, ctl: RunControl) -> Result<
         }
     };
 
+    if built.spec.output.net_forces {
+        sim.record_net_forces();
+    }
     if dt_halvings > 0 {
         let dt_s = built.dt_s / f64::from(1u32 << dt_halvings.min(30));
         if sim.dt_s != dt_s {
@@ -425,7 +467,7 @@ pub fn run_in_dir(built: &BuiltScenario, out: &Path, ctl: RunControl) -> Result<
             .min(stop_at);
         sim.run_steps(next - sim.step)?;
         if sim.step % built.spec.output.series_every_steps == 0 {
-            let row = format!("{}{}", series_row(&sim, built), observer.extra_row(&sim));
+            let row = format!("{}{}", series_row(&mut sim, built), observer.extra_row(&sim));
             writeln!(series_file, "{row}").map_err(|e| Error::io("write", &series_path, e))?;
         }
         if sim.step % built.spec.output.checkpoint_every_steps == 0 || sim.step == total_steps {

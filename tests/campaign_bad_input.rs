@@ -491,6 +491,21 @@ const CASES: &[(&str, &str, &str, &[&str])] = &[
         &["key `metrics[4]`", "`coating_variability` needs a spray"],
     ),
     (
+        "net-force metric without a gas",
+        "coordination_number]",
+        "coordination_number, overshoot_sidewall_friction_per_weight]",
+        &[
+            "key `metrics[4]`",
+            "`overshoot_sidewall_friction_per_weight` needs a gas",
+        ],
+    ),
+    (
+        "net_forces not a boolean",
+        "output: { series_every_steps: 50 }",
+        "output: { series_every_steps: 50, net_forces: sometimes }",
+        &["base.output.net_forces", "expected a boolean"],
+    ),
+    (
         "unknown cycle pressure reading",
         "analysis: { mixing_species: red }",
         "analysis: { mixing_species: red, cycle_pressure: first_nod }",

@@ -33,8 +33,14 @@ gas:
   pressure_probe_height_m: 0.02
 {extra}
 time: {{ dt_s: 1.0e-5, end_time_s: {end_time_s} }}
-output: {{ checkpoint_every_steps: 1000, keep_checkpoints: 2, series_every_steps: 70 }}
-"#
+output: {{ checkpoint_every_steps: 1000, keep_checkpoints: 2, series_every_steps: 70{net_forces} }}
+"#,
+        extra = extra.replace(NET_FORCES, ""),
+        net_forces = if extra.contains(NET_FORCES) {
+            ", net_forces: true"
+        } else {
+            ""
+        },
     )
 }
 
@@ -105,6 +111,20 @@ fn a_bed_under_stepped_inflow_levels_restarts_bit_identically() {
     // Levels of 4 ms from 5 ms: the stop at 15 ms falls in the third level (the gas off).
     restart_is_exact("  inflow_levels: { start_s: 0.005, hold_s: 0.004, factors: [1.0, 0.5, 0.0, 0.5, 1.0] }");
 }
+
+/// The net-force sums run across the stop at step 1503, between two series rows (1470 and 1540): the checkpoint
+/// carries them, so the resumed run writes the same row at 1540.
+#[test]
+fn a_cohesive_bed_recording_net_forces_restarts_bit_identically() {
+    restart_is_exact(&format!("{HAMAKER_WITH_WALLS}\n{NET_FORCES}"));
+}
+
+/// Hamaker cohesion between beads and with the walls, about one bead weight at contact.
+const HAMAKER_WITH_WALLS: &str =
+    "cohesion: { hamaker: { constant_j: 3.0e-19, inner_cutoff_m: 4.0e-10, outer_cutoff_m: 1.0e-5, walls: true } }";
+
+/// Marks a `bed` to record net forces (replaced by the output line in [`bed`]).
+const NET_FORCES: &str = "# net_forces";
 
 fn restart_is_exact(extra: &str) {
     let tmp = tempfile::tempdir().expect("temp dir");
@@ -191,6 +211,83 @@ fn the_series_holds_the_first_node_pressure_drop_and_the_weight_above_that_node(
     assert!(
         node_pa > 0.5 * weight_pa && node_pa < column_pa,
         "node {node_pa}, column {column_pa}, W'/A {weight_pa}"
+    );
+}
+
+/// The net force by mechanism closes the bed's momentum balance exactly. Velocity Verlet kicks each step with the
+/// mean of two consecutive forces, so over steps 2000-3000 the change of the vertical momentum is
+/// ΔP = dt [Σ_k (F_k − W) + (F_2000 − F_3000)/2], k = 2001..3000, where F_k, the force on all particles, is what
+/// the series splits into gas, wall contact and wall cohesion (particle–particle forces cancel), and the end terms
+/// are the force totals in the two checkpoints. The bed is cohesive, lands on the distributor during the window
+/// (a large, changing force), and the distributor's cohesion pulls it down.
+#[test]
+fn the_net_forces_by_mechanism_close_the_momentum_balance_of_a_cohesive_bed() {
+    let tmp = tempfile::tempdir().expect("temp dir");
+    let dir = tmp.path();
+    // Beads touching from the start, the lowest row on the distributor, under a gas too slow to lift them.
+    let text = bed(0.03, &format!("{HAMAKER_WITH_WALLS}\n{NET_FORCES}"))
+        .replace("series_every_steps: 70", "series_every_steps: 50")
+        .replace("spacing_m: 0.003", "spacing_m: 0.0027")
+        .replace(
+            "origin_m: [0.0015, 0.0015, 0.00135]",
+            "origin_m: [0.00135, 0.00135, 0.00135]",
+        )
+        .replace("superficial_velocity_m_per_s: 2.5", "superficial_velocity_m_per_s: 1.0");
+    std::fs::write(dir.join("bed.yaml"), text).unwrap();
+    run_ok(
+        &["simulate", "bed.yaml", "--out", "bed", "--max-steps", "2000", "--quiet"],
+        dir,
+    );
+    let before = final_state(&dir.join("bed"));
+    run_ok(&["simulate", "bed.yaml", "--out", "bed", "--quiet"], dir);
+    let after = final_state(&dir.join("bed"));
+    assert_eq!((before.step, after.step), (2000, 3000));
+    let momentum = |s: &SimState| -> f64 {
+        let p = &s.particles;
+        (0..p.len()).map(|i| p.mass_kg[i] * p.velocity_m_per_s[i].y).sum()
+    };
+    let series = std::fs::read_to_string(dir.join("bed/series.csv")).unwrap();
+    let header: Vec<&str> = series.lines().next().unwrap().split(',').collect();
+    let column = |name: &str| {
+        header
+            .iter()
+            .position(|h| *h == name)
+            .unwrap_or_else(|| panic!("column {name}"))
+    };
+    let up_forces: Vec<usize> = header
+        .iter()
+        .enumerate()
+        .filter(|(_, h)| h.ends_with("_up_n"))
+        .map(|(k, _)| k)
+        .collect();
+    // The gas, and contact and cohesion of the box's four walls (box_y_lo, box_y_hi, box_z_lo, box_z_hi; x is periodic).
+    assert_eq!(up_forces.len(), 1 + 2 * 4, "{header:?}");
+    let (step, weight) = (column("step"), column("weight_n"));
+    let (mut net_sum, mut rows) = (0.0, 0);
+    for line in series.lines().skip(1) {
+        let fields: Vec<f64> = line.split(',').map(|f| f.parse().unwrap()).collect();
+        if fields[step] > 2000.0 {
+            net_sum += up_forces.iter().map(|&k| fields[k]).sum::<f64>() - fields[weight];
+            rows += 1;
+        }
+    }
+    assert_eq!(rows, 20);
+    let weight_n = before.particles.mass_kg.iter().sum::<f64>() * 9.81;
+    let total_up = |s: &SimState| s.particles.force_n.iter().map(|f| f.y).sum::<f64>();
+    // Σ_k (F_k − W) over the 1000 steps, from the 20 row means of 50 steps each.
+    let summed_n = 50.0 * net_sum + 0.5 * (total_up(&before) - total_up(&after));
+    let expected_n = (momentum(&after) - momentum(&before)) / 1.0e-5;
+    assert!(
+        (summed_n - expected_n).abs() < 1e-9 * 1000.0 * weight_n,
+        "net forces summed {summed_n:e} N against ΔP/dt {expected_n:e} N (W = {weight_n:e} N)"
+    );
+    // Without the end terms the balance would be off by this much: the test can tell.
+    assert!((total_up(&before) - total_up(&after)).abs() > 1e-3 * weight_n);
+    // Landed, the bottom row of beads is held down (about −0.12 W; walls act at twice the pair force).
+    let landed = last_row_value(&series, "wall_box_y_lo_cohesion_up_n");
+    assert!(
+        landed < -0.05 * weight_n,
+        "the distributor's cohesion pulls the bed down: {landed:e} N"
     );
 }
 

@@ -108,6 +108,8 @@ pub struct CycleVelocities {
     pub incipient_m_per_s: f64,
     /// The overshoot peak's pressure drop over W/A (above 1: an overshoot).
     pub overshoot_ratio: f64,
+    /// Index (into the levels given) of the top of the rising branch's climb, the overshoot peak when above W/A.
+    pub peak_level: Option<usize>,
 }
 
 /// The packed-bed points of a branch (CHOICE: seed 001 fits "all packed-bed points" without a rule; here the run of
@@ -153,14 +155,18 @@ pub fn cycle_velocities(levels: &[CycleLevel], bed_weight_per_area_pa: f64) -> C
     // the bed has given way; the peak is the last level of the climb before it. Level means of a bubbling bed
     // swing by up to 10 % from one level to the next (D8's 0.1 s levels, averaged over 0.05 s), so a window reaching into it
     // would count bubbles as an overshoot.
-    let mut climb = rising.iter().take_while(|l| l.pressure_drop_mean_pa.is_finite());
-    let mut peak = climb.next();
-    for l in climb {
-        match peak {
-            Some(p) if l.pressure_drop_mean_pa < p.pressure_drop_mean_pa => break,
-            _ => peak = Some(l),
+    let mut climb = rising
+        .iter()
+        .enumerate()
+        .take_while(|(_, l)| l.pressure_drop_mean_pa.is_finite());
+    let mut top = climb.next();
+    for (k, l) in climb {
+        match top {
+            Some((_, p)) if l.pressure_drop_mean_pa < p.pressure_drop_mean_pa => break,
+            _ => top = Some((k, l)),
         }
     }
+    let peak = top.map(|(_, l)| l);
     let overshoot_ratio = peak.map_or(f64::NAN, |l| l.pressure_drop_mean_pa / bed_weight_per_area_pa);
     CycleVelocities {
         defluidization_m_per_s: crossing(&mut falling.iter().rev()),
@@ -170,6 +176,7 @@ pub fn cycle_velocities(levels: &[CycleLevel], bed_weight_per_area_pa: f64) -> C
             _ => f64::NAN,
         },
         overshoot_ratio,
+        peak_level: top.map(|(k, _)| slowest + k),
     }
 }
 
@@ -245,6 +252,7 @@ mod tests {
         );
         assert_eq!(c.incipient_m_per_s, 1.8);
         assert!((c.overshoot_ratio - 1.15).abs() < 1e-12);
+        assert_eq!(c.peak_level, Some(12), "the 1.8 m/s level, the 13th");
         // Without an overshoot there is no incipient velocity.
         let flat: Vec<CycleLevel> = levels
             .iter()
@@ -263,6 +271,7 @@ mod tests {
         let c = cycle_velocities(&dry, 1000.0);
         assert!((c.overshoot_ratio - 0.985).abs() < 1e-12, "{c:?}");
         assert!(c.incipient_m_per_s.is_nan());
+        assert_eq!(c.peak_level, Some(12), "the climb's top, 1.6 m/s");
     }
 
     #[test]

@@ -31,6 +31,8 @@ pub enum Need {
     InflowLevels,
     /// A spray (`liquid_bridge.spray`).
     Spray,
+    /// `output.net_forces` (the net force by mechanism in the series).
+    NetForces,
 }
 
 impl Need {
@@ -71,6 +73,10 @@ impl Need {
                     Some(CohesionModel::LiquidBridge(LiquidBridge { spray: Some(_), .. }))
                 ),
                 format!("`{name}` needs a spray (`cohesion: {{ liquid_bridge: {{ spray: ... }} }}`)"),
+            ),
+            Need::NetForces => unless(
+                scenario.output.net_forces,
+                format!("`{name}` needs `output.net_forces: true` (the net force by mechanism in the series)"),
             ),
         }
     }
@@ -238,6 +244,30 @@ pub const METRICS: &[MetricInfo] = &[
         unit: "1",
         description: "the overshoot peak (see incipient_fluidization_velocity_m_per_s) over W/A (above 1: an overshoot)",
         needs: &[Need::Gas, Need::InflowLevels],
+    },
+    MetricInfo {
+        name: "overshoot_fluid_force_per_weight",
+        unit: "1",
+        description: "the gas's force on all particles (its component against gravity) over their weight, averaged over the second half of the overshoot peak's level (see incipient_fluidization_velocity_m_per_s; the climb's top when there is no overshoot); seed 001 Figs 8.8-8.16",
+        needs: &[Need::Gas, Need::InflowLevels, Need::NetForces],
+    },
+    MetricInfo {
+        name: "overshoot_distributor_contact_per_weight",
+        unit: "1",
+        description: "the same for the contact force of the distributor (the plane walls facing against gravity)",
+        needs: &[Need::Gas, Need::InflowLevels, Need::NetForces],
+    },
+    MetricInfo {
+        name: "overshoot_distributor_cohesion_per_weight",
+        unit: "1",
+        description: "the same for the distributor's cohesion (negative: it holds the bed down)",
+        needs: &[Need::Gas, Need::InflowLevels, Need::NetForces],
+    },
+    MetricInfo {
+        name: "overshoot_sidewall_friction_per_weight",
+        unit: "1",
+        description: "the same for the sidewalls (plane walls parallel to gravity): their friction, with any tangential force of their cohesion (negative: they hold the bed down)",
+        needs: &[Need::Gas, Need::InflowLevels, Need::NetForces],
     },
     MetricInfo {
         name: "stepped_fluidization_velocity_m_per_s",

@@ -25,6 +25,7 @@ use crate::engine::cohesion::{CohesionState, CohesionStore};
 use crate::engine::contacts::{ContactStore, WallId};
 use crate::engine::gas::coupled::{GasSnapshot, GasStepStats};
 use crate::engine::models::ContactHistory;
+use crate::engine::net_force::NetForceTally;
 use crate::engine::particles::{ParticleId, Particles, SpeciesId};
 use crate::engine::state::{RngState, SimState};
 
@@ -56,6 +57,10 @@ pub(crate) enum Rows {
     CohesionPairs,
     /// The number of particle–wall pairs with a cohesion state.
     CohesionWalls,
+    /// One row when the run sums net forces by mechanism, none otherwise.
+    NetForce,
+    /// The number of walls when the run sums net forces by mechanism, 0 otherwise.
+    NetForceWalls,
 }
 
 /// One dataset of the layout.
@@ -233,6 +238,11 @@ datasets! {
     cohesion_wall_wall: u16 => "cohesion/walls/wall", Rows::CohesionWalls, 1, "1";
     cohesion_wall_bridge_volume_m3: f64 => "cohesion/walls/bridge_volume_m3", Rows::CohesionWalls, 1, "m3";
     cohesion_wall_in_well: u8 => "cohesion/walls/in_well", Rows::CohesionWalls, 1, "1";
+
+    net_force_steps: u64 => "net_force/steps", Rows::NetForce, 1, "1";
+    net_force_fluid_n: f64 => "net_force/fluid_sum_n", Rows::NetForce, 3, "N";
+    net_force_wall_contact_n: f64 => "net_force/wall_contact_sum_n", Rows::NetForceWalls, 3, "N";
+    net_force_wall_cohesion_n: f64 => "net_force/wall_cohesion_sum_n", Rows::NetForceWalls, 3, "N";
 }
 
 /// Groups to create before the datasets, parents first.
@@ -248,6 +258,7 @@ pub(crate) const GROUPS: &[&str] = &[
     "cohesion",
     "cohesion/pairs",
     "cohesion/walls",
+    "net_force",
 ];
 
 /// The scalar part of a checkpoint: the root attributes other than `format` and the checksum.
@@ -425,6 +436,23 @@ impl Arrays {
                 .iter()
                 .map(|(_, _, c)| u8::from(c.in_well))
                 .collect(),
+
+            net_force_steps: state.net_force.as_ref().map(|t| t.steps).into_iter().collect(),
+            net_force_fluid_n: state
+                .net_force
+                .as_ref()
+                .map(|t| flatten(&[t.fluid_n]))
+                .unwrap_or_default(),
+            net_force_wall_contact_n: state
+                .net_force
+                .as_ref()
+                .map(|t| flatten(&t.wall_contact_n))
+                .unwrap_or_default(),
+            net_force_wall_cohesion_n: state
+                .net_force
+                .as_ref()
+                .map(|t| flatten(&t.wall_cohesion_n))
+                .unwrap_or_default(),
         }
     }
 
@@ -478,6 +506,14 @@ impl Arrays {
             if (len > 0) != (gas_scalars == 1) {
                 return Err(format!("/{path} has {len} values but /gas/time_s has {gas_scalars}"));
             }
+        }
+        let tallies = self.net_force_steps.len();
+        let tally_walls = self.net_force_wall_contact_n.len() / 3;
+        if tallies > 1 || tally_walls != tallies * n_walls {
+            return Err(format!(
+                "/net_force/steps has {tallies} elements and /net_force/wall_contact_sum_n {tally_walls} rows, \
+                 expected none, or 1 and one row per wall ({n_walls})"
+            ));
         }
         if let Some(&v) = self.gas_last_converged.first().filter(|&&v| v > 1) {
             return Err(format!("/gas/last_step/converged is {v}, expected 0 or 1"));
@@ -585,8 +621,15 @@ impl Arrays {
                 converged: self.gas_last_converged[0] == 1,
             },
         });
+        let net_force = (self.net_force_steps.len() == 1).then(|| NetForceTally {
+            steps: self.net_force_steps[0],
+            fluid_n: unflatten(&self.net_force_fluid_n)[0],
+            wall_contact_n: unflatten(&self.net_force_wall_contact_n),
+            wall_cohesion_n: unflatten(&self.net_force_wall_cohesion_n),
+        });
         SimState {
             gas,
+            net_force,
             step: header.step,
             time_s: header.time_s,
             dt_s: header.dt_s,

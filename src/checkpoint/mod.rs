@@ -31,7 +31,7 @@ use crate::engine::SimState;
 
 /// Version of the file layout. Bump it whenever a name, type, shape or the checksum definition changes; readers
 /// reject any other version with [`CheckpointError::Version`].
-pub const CHECKPOINT_FORMAT_VERSION: u32 = 3;
+pub const CHECKPOINT_FORMAT_VERSION: u32 = 4;
 
 /// Metadata stored beside the state.
 #[derive(Debug, Clone, PartialEq)]
@@ -412,6 +412,8 @@ fn expected_shape(spec: &DatasetSpec) -> String {
         Rows::GasScalar => "0 or 1".to_string(),
         Rows::CohesionPairs => "cohesion pairs".to_string(),
         Rows::CohesionWalls => "cohesion wall pairs".to_string(),
+        Rows::NetForce => "0 or 1".to_string(),
+        Rows::NetForceWalls => "0 or walls".to_string(),
     };
     if spec.width == 1 {
         format!("[{rows}]")
@@ -524,6 +526,13 @@ mod tests {
                 stream: 0xdead_beef_1234_5678,
                 word_pos: (1u128 << 70) + 12_345,
             },
+            // Net-force sums for the two walls.
+            net_force: Some(crate::engine::net_force::NetForceTally {
+                steps: 37,
+                fluid_n: Vec3::new(1.0e-3, 0.25, -DISTINCTIVE),
+                wall_contact_n: vec![Vec3::new(0.0, 2.5, 1e-300), Vec3::new(-0.125, 3.0e-7, 0.0)],
+                wall_cohesion_n: vec![Vec3::new(0.0, -0.5, 0.0), Vec3::new(7.0, 0.0, -1.0e-9)],
+            }),
             // A 2 × 3 × 1 gas grid: 6 cells, 9 / 8 / 12 faces.
             gas: Some(crate::engine::gas::coupled::GasSnapshot {
                 pressure_pa: (0..6).map(|k| 101.5 * k as f64 - 3.0).collect(),

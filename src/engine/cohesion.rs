@@ -457,7 +457,9 @@ pub struct CohesionPass {
 
 /// Adds the cohesion forces at the current positions (velocities at the half step) to `p.force_n` and
 /// `p.torque_n_m`, updating `state` and the particles' liquid. `dt_s` turns the square well's crossing impulses
-/// into forces acting for one step (the two half kicks of velocity Verlet deliver exactly F dt).
+/// into forces acting for one step (the two half kicks of velocity Verlet deliver exactly F dt). With `per_wall_n`,
+/// each wall's cohesion force on all particles is added there too (index = wall, particles ascending).
+#[allow(clippy::too_many_arguments)]
 pub fn apply_cohesion(
     cohesion: &Cohesion,
     config: &SimConfig,
@@ -466,6 +468,7 @@ pub fn apply_cohesion(
     state: &mut AlignedCohesion,
     wall_angle_rad: &[f64],
     dt_s: f64,
+    mut per_wall_n: Option<&mut [Vec3]>,
 ) -> CohesionPass {
     let n = p.len();
     let mut pass = CohesionPass::default();
@@ -613,6 +616,7 @@ pub fn apply_cohesion(
                     continue;
                 }
                 let approach = -(vi - prox.wall_velocity).dot(&prox.normal);
+                let mut tangential = Vec3::zeros();
                 let force = match cohesion.model {
                     CohesionModel::LiquidBridge(b) => {
                         let (ti, tw) = (
@@ -645,7 +649,7 @@ pub fn apply_cohesion(
                                 );
                                 let contact_velocity = vi - prox.wall_velocity - (wi * ri).cross(&prox.normal);
                                 let ut = contact_velocity - prox.normal * contact_velocity.dot(&prox.normal);
-                                let tangential = -ut * coefficient;
+                                tangential = -ut * coefficient;
                                 p.force_n[i] += tangential;
                                 p.torque_n_m[i] -= prox.normal.cross(&tangential) * ri;
                             }
@@ -681,6 +685,9 @@ pub fn apply_cohesion(
                     }
                 };
                 p.force_n[i] += prox.normal * force;
+                if let Some(out) = per_wall_n.as_deref_mut() {
+                    out[w] += tangential + prox.normal * force;
+                }
             }
         }
     }

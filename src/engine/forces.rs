@@ -230,7 +230,37 @@ struct Body {
     species: SpeciesId,
 }
 
-impl Context<'_> {
+impl<'a> Context<'a> {
+    /// The context of a pass over `p` (whose per-particle properties it holds; positions and velocities are read
+    /// through a [`Motion`]).
+    #[allow(clippy::too_many_arguments)]
+    fn new(
+        config: &'a SimConfig,
+        p: &'a Particles,
+        inverse: &'a InverseInertia,
+        wall_angle: &'a [f64],
+        dt_s: f64,
+        kick: Option<HalfKick>,
+        reference: &'a [Vec3],
+        accumulators_zeroed: bool,
+    ) -> Self {
+        Context {
+            config,
+            law: &config.contact_law,
+            table: &config.pair_table,
+            radius_m: &p.radius_m,
+            mass_kg: &p.mass_kg,
+            species: &p.species,
+            inv_mass_per_kg: &inverse.inv_mass_per_kg,
+            inv_inertia_per_kg_m2: &inverse.inv_inertia_per_kg_m2,
+            wall_angle,
+            dt_s,
+            kick,
+            reference,
+            accumulators_zeroed,
+        }
+    }
+
     #[inline(always)]
     fn body(&self, i: usize, vel: &impl Motion) -> Body {
         Body {
@@ -501,21 +531,16 @@ pub fn compute_contact_forces(
     } else {
         &[]
     };
-    let ctx = Context {
+    let ctx = Context::new(
         config,
-        law: &config.contact_law,
-        table: &config.pair_table,
-        radius_m: &p.radius_m,
-        mass_kg: &p.mass_kg,
-        species: &p.species,
-        inv_mass_per_kg: &inverse.inv_mass_per_kg,
-        inv_inertia_per_kg_m2: &inverse.inv_inertia_per_kg_m2,
+        p,
+        inverse,
         wall_angle,
         dt_s,
         kick,
         reference,
         accumulators_zeroed,
-    };
+    );
     // One instantiation per history layout: the layout decides which history fields exist, and knowing it at
     // compile time lets the kernels' unused fields vanish from the loop.
     let layout = config.contact_law.history_layout();
@@ -561,6 +586,63 @@ pub fn compute_contact_forces(
     p.velocity_m_per_s = velocity;
     p.angular_velocity_rad_per_s = omega;
     pass
+}
+
+/// Adds each wall's contact force on all particles to `per_wall_n` (index = wall), exactly as the next force pass
+/// will compute it: same positions, velocities and history, the same kernel, with the history left untouched. For
+/// the net-force split ([`super::net_force`]); call it right before that pass. Particles are summed in ascending
+/// order, so the sums do not depend on the thread count.
+#[allow(clippy::too_many_arguments)]
+pub fn add_wall_contact_forces(
+    config: &SimConfig,
+    p: &Particles,
+    inverse: &InverseInertia,
+    wall_angle: &[f64],
+    dt_s: f64,
+    list: &NeighborList,
+    history: &AlignedHistory,
+    per_wall_n: &mut [Vec3],
+) {
+    let ctx = Context::new(config, p, inverse, wall_angle, dt_s, None, &[], false);
+    let motion = Plain {
+        x: &p.position_m,
+        v: &p.velocity_m_per_s,
+        w: &p.angular_velocity_rad_per_s,
+    };
+    let mut scratch = history.wall.clone();
+    let layout = config.contact_law.history_layout();
+    macro_rules! run {
+        ($wb:literal, $th:literal) => {{
+            let mut walls = scratch.view();
+            let mut worst = WorstOverlap::NONE;
+            for i in 0..p.len() {
+                let slots = list.walls_of(i);
+                for k in slots {
+                    let wall = list.wall_partner[k];
+                    let (mut f, mut t) = (Vec3::zeros(), Vec3::zeros());
+                    ctx.walls::<$wb, $th>(
+                        i,
+                        motion.x(i),
+                        motion.v(i),
+                        motion.w(i),
+                        &[wall],
+                        &mut walls,
+                        k,
+                        &mut f,
+                        &mut t,
+                        &mut worst,
+                    );
+                    per_wall_n[wall as usize] += f;
+                }
+            }
+        }};
+    }
+    match (layout.walton_braun, layout.thornton) {
+        (false, false) => run!(false, false),
+        (true, false) => run!(true, false),
+        (false, true) => run!(false, true),
+        (true, true) => run!(true, true),
+    }
 }
 
 #[allow(clippy::too_many_arguments)]

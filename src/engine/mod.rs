@@ -11,6 +11,7 @@ pub mod geometry;
 pub mod integrate;
 pub mod models;
 pub mod neighbor;
+pub mod net_force;
 pub mod particles;
 pub mod simulation;
 pub mod spray;

@@ -10,13 +10,14 @@ use std::time::{Duration, Instant};
 
 use super::cohesion::{AlignedCohesion, Cohesion, CohesionPass, apply_cohesion, total_liquid_m3};
 use super::contacts::AlignedHistory;
-use super::forces::{ForcePass, HalfKick, PairBuffers, RangePlan, compute_contact_forces};
+use super::forces::{ForcePass, HalfKick, PairBuffers, RangePlan, add_wall_contact_forces, compute_contact_forces};
 use super::gas::coupled::GasCoupling;
 use super::geometry::{Domain, Gravity, Wall};
 use super::integrate::{InverseInertia, find_lost, kick_drift};
 use super::models::cohesion_law::{CohesionModel, LiquidBridge};
 use super::models::{ContactLaw, PairTable};
 use super::neighbor::{NeighborList, Reach};
+use super::net_force::NetForceTally;
 use super::particles::{ParticleId, Particles, SpeciesTable};
 use super::spray::spray_surface;
 use super::state::{RngState, SimState};
@@ -110,6 +111,9 @@ pub struct Simulation {
     /// before the contact pass adds onto them, so the pass itself is unchanged and any thread count gives the same
     /// bits. The gas steps after every `dem_steps_per_gas_step`-th DEM step.
     pub gas: Option<Box<GasCoupling>>,
+    /// The net force on the particles by mechanism, summed every step when asked for
+    /// ([`Simulation::record_net_forces`]); a diagnostic that never feeds back into the motion.
+    pub net_force: Option<NetForceTally>,
 }
 
 impl Simulation {
@@ -141,6 +145,7 @@ impl Simulation {
             ranges: RangePlan::default(),
             pending_drift: None,
             gas: None,
+            net_force: None,
             accumulators_zeroed: false,
             steps_since_rebalance: 0,
             pool: make_pool(threads),
@@ -176,6 +181,7 @@ impl Simulation {
             ranges: RangePlan::default(),
             pending_drift: None,
             gas: None,
+            net_force: state.net_force,
             accumulators_zeroed: false,
             steps_since_rebalance: 0,
             pool: make_pool(threads),
@@ -221,6 +227,7 @@ impl Simulation {
             cohesion: self.cohesion.to_store(&self.list),
             rng: self.rng,
             gas: self.gas.as_ref().map(|g| g.snapshot()),
+            net_force: self.net_force.clone(),
         }
     }
 
@@ -396,6 +403,10 @@ impl Simulation {
             // sleeping workers took tens of µs to wake, more than the work of a few thousand particles).
             let team = (p.len() >= PARALLEL_FLUID_FORCES_MIN_PARTICLES).then_some(&self.team);
             fluid.add_forces(&p.position_m, &p.velocity_m_per_s, &p.radius_m, &mut p.force_n, team);
+            if let Some(tally) = self.net_force.as_mut() {
+                // The arrays were zero: they hold exactly the gas's forces.
+                tally.fluid_n += p.force_n.iter().fold(Vec3::zeros(), |sum, f| sum + f);
+            }
             self.timers.fluid_forces += t.elapsed();
         }
         self.apply_cohesion(dt);
@@ -404,6 +415,19 @@ impl Simulation {
             dt_s: dt,
             fuse_next_drift,
         };
+        if let Some(tally) = self.net_force.as_mut() {
+            add_wall_contact_forces(
+                &config,
+                &self.particles,
+                &self.inverse,
+                &self.wall_angle_rad,
+                dt,
+                &self.list,
+                &self.history,
+                &mut tally.wall_contact_n,
+            );
+            tally.steps += 1;
+        }
         let pass = self.forces(dt, Some(kick));
         if fuse_next_drift {
             self.pending_drift = Some(pass.max_displacement2_m2);
@@ -511,11 +535,20 @@ impl Simulation {
             &mut self.cohesion,
             &self.wall_angle_rad,
             dt,
+            self.net_force.as_mut().map(|t| t.wall_cohesion_n.as_mut_slice()),
         );
         self.cohesion_events.bridges_formed += pass.bridges_formed;
         self.cohesion_events.bridges_ruptured += pass.bridges_ruptured;
         self.cohesion_events.well_crossings += pass.well_crossings;
         self.timers.cohesion += t.elapsed();
+    }
+
+    /// Starts summing the net force on the particles by mechanism every step (see [`NetForceTally`]), unless
+    /// it already does (a run restored with its sums); read and restart the sums with `net_force.take_means()`.
+    pub fn record_net_forces(&mut self) {
+        if self.net_force.is_none() {
+            self.net_force = Some(NetForceTally::new(self.config.walls.len()));
+        }
     }
 
     /// Liquid on the particles plus liquid in bridges, m³.

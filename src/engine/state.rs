@@ -10,6 +10,7 @@ use super::cohesion::{CohesionState, CohesionStore};
 use super::contacts::ContactStore;
 use super::gas::coupled::GasSnapshot;
 use super::models::ContactHistory;
+use super::net_force::NetForceTally;
 use super::particles::{ParticleId, Particles};
 
 /// The complete state of a ChaCha8 generator: seed, stream and position.
@@ -57,6 +58,9 @@ pub struct SimState {
     pub rng: RngState,
     /// The gas of a coupled run.
     pub gas: Option<GasSnapshot>,
+    /// The net-force sums since the last series row, when the run records them (a diagnostic, but a run resumed
+    /// from here must write the same rows).
+    pub net_force: Option<NetForceTally>,
 }
 
 /// Bit-level comparison of two states: `None` when every value is identical to the bit (`to_bits()` for floats),
@@ -186,6 +190,20 @@ pub fn first_difference(a: &SimState, b: &SimState) -> Option<String> {
         if gas.is_some() {
             return gas;
         }
+    }
+    match (&a.net_force, &b.net_force) {
+        (Some(x), Some(y)) => {
+            let sums = (x.steps != y.steps)
+                .then(|| format!("net_force.steps: {} vs {}", x.steps, y.steps))
+                .or_else(|| v("net_force.fluid_n", &x.fluid_n, &y.fluid_n))
+                .or_else(|| vectors("net_force.wall_contact_n", &x.wall_contact_n, &y.wall_contact_n))
+                .or_else(|| vectors("net_force.wall_cohesion_n", &x.wall_cohesion_n, &y.wall_cohesion_n));
+            if sums.is_some() {
+                return sums;
+            }
+        }
+        (None, None) => {}
+        _ => return Some("net_force: present in one state only".into()),
     }
     f("time_s", a.time_s, b.time_s)
         .or_else(|| f("dt_s", a.dt_s, b.dt_s))

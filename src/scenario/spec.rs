@@ -198,6 +198,12 @@ pub struct OutputSpec {
     pub keep_checkpoints: usize,
     #[serde(default = "default_series_every")]
     pub series_every_steps: u64,
+    /// Add the net force on the particles by mechanism to the series (seed 001 ch. 8, Figs 8.8–8.16): the weight,
+    /// the gas's force, and each wall's contact and cohesion forces, as components against gravity (N), averaged
+    /// over the steps since the previous row or checkpoint. Particle–particle forces cancel in the sum. Default:
+    /// false.
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub net_forces: bool,
 }
 
 fn default_checkpoint_every() -> u64 {
@@ -216,6 +222,7 @@ impl Default for OutputSpec {
             checkpoint_every_steps: default_checkpoint_every(),
             keep_checkpoints: default_keep(),
             series_every_steps: default_series_every(),
+            net_forces: false,
         }
     }
 }

@@ -8,9 +8,9 @@ use crate::analysis;
 use crate::campaign::JobSpec;
 use crate::campaign::metrics::info;
 use crate::campaign::spec::CyclePressure;
-use crate::engine::Simulation;
 use crate::engine::models::cohesion_law::CohesionModel;
 use crate::engine::particles::SpeciesId;
+use crate::engine::{Simulation, Vec3};
 use crate::error::Error;
 use crate::scenario::BuiltScenario;
 
@@ -212,6 +212,16 @@ pub fn metrics(job: &JobSpec, built: &BuiltScenario, sim: &Simulation, series: &
                 cycle(job, built, sim, series).map_or(f64::NAN, |c| c.incipient_m_per_s)
             }
             "pressure_overshoot_ratio" => cycle(job, built, sim, series).map_or(f64::NAN, |c| c.overshoot_ratio),
+            "overshoot_fluid_force_per_weight" => overshoot_net_force(NetForcePart::Fluid, job, built, sim, series),
+            "overshoot_distributor_contact_per_weight" => {
+                overshoot_net_force(NetForcePart::DistributorContact, job, built, sim, series)
+            }
+            "overshoot_distributor_cohesion_per_weight" => {
+                overshoot_net_force(NetForcePart::DistributorCohesion, job, built, sim, series)
+            }
+            "overshoot_sidewall_friction_per_weight" => {
+                overshoot_net_force(NetForcePart::SidewallFriction, job, built, sim, series)
+            }
             "stepped_fluidization_velocity_m_per_s" => stepped_onset_m_per_s(job, built, sim, series),
             other => return Err(Error::External(format!("metric `{other}` has no reducer"))),
         };
@@ -336,6 +346,8 @@ fn random_mixture_intensity(job: &JobSpec, sim: &Simulation) -> f64 {
 /// W'/A, averaged over the same window (particles cross the node as the bed moves); otherwise the column's pressure
 /// drop against W/A of the whole bed.
 struct LevelStats {
+    /// The level's time window (the second half of its hold), s.
+    window_s: (f64, f64),
     velocity_m_per_s: f64,
     pressure_drop_mean_pa: f64,
     pressure_drop_std_pa: f64,
@@ -370,6 +382,7 @@ fn level_stats(job: &JobSpec, built: &BuiltScenario, sim: &Simulation, series: &
             let window: Vec<f64> = rows.iter().map(|&k| dp[k]).collect();
             let ramp = gas.inflow_ramp.map_or(1.0, |r| r.factor(from));
             (!window.is_empty()).then(|| LevelStats {
+                window_s: (from, to),
                 velocity_m_per_s: u * factor * ramp,
                 pressure_drop_mean_pa: mean(&window),
                 pressure_drop_std_pa: std_dev(&window),
@@ -389,14 +402,97 @@ fn cycle(
     sim: &Simulation,
     series: &Series,
 ) -> Option<analysis::fluidization::CycleVelocities> {
-    let points: Vec<analysis::fluidization::CycleLevel> = level_stats(job, built, sim, series)?
+    cycle_and_levels(job, built, sim, series).map(|(c, _)| c)
+}
+
+/// [`cycle`] and the levels it was read from.
+fn cycle_and_levels(
+    job: &JobSpec,
+    built: &BuiltScenario,
+    sim: &Simulation,
+    series: &Series,
+) -> Option<(analysis::fluidization::CycleVelocities, Vec<LevelStats>)> {
+    let levels = level_stats(job, built, sim, series)?;
+    let points: Vec<analysis::fluidization::CycleLevel> = levels
         .iter()
         .map(|l| analysis::fluidization::CycleLevel {
             velocity_m_per_s: l.velocity_m_per_s,
             pressure_drop_mean_pa: l.pressure_drop_mean_pa / l.weight_per_area_pa,
         })
         .collect();
-    (points.len() >= 3).then(|| analysis::fluidization::cycle_velocities(&points, 1.0))
+    (points.len() >= 3).then(|| (analysis::fluidization::cycle_velocities(&points, 1.0), levels))
+}
+
+/// Which mechanism of the net-force split (seed 001 Figs 8.8-8.16) an `overshoot_*_per_weight` metric reads.
+#[derive(Clone, Copy)]
+enum NetForcePart {
+    Fluid,
+    DistributorContact,
+    DistributorCohesion,
+    SidewallFriction,
+}
+
+/// A net-force part over the weight, averaged over the second half of the cycle's overshoot peak level (the
+/// climb's top): the series' `*_up_n` columns over `weight_n`. The distributor is every plane wall whose normal
+/// points against gravity, the sidewalls every plane wall parallel to it (normals checked at the bed's centroid).
+fn overshoot_net_force(
+    part: NetForcePart,
+    job: &JobSpec,
+    built: &BuiltScenario,
+    sim: &Simulation,
+    series: &Series,
+) -> f64 {
+    let Some((cycle, levels)) = cycle_and_levels(job, built, sim, series) else {
+        return f64::NAN;
+    };
+    let (Some(peak), Some(t), Some(weight)) = (cycle.peak_level, series.column("time_s"), series.column("weight_n"))
+    else {
+        return f64::NAN;
+    };
+    let Some(up) = (-sim.config.gravity.at(sim.time_s)).try_normalize(0.0) else {
+        return f64::NAN;
+    };
+    let p = &sim.particles;
+    let centroid = p.position_m.iter().fold(Vec3::zeros(), |s, x| s + x) / p.len().max(1) as f64;
+    // Wall names whose columns make up this part, with the column suffix.
+    let walls = |facing: &dyn Fn(f64) -> bool| -> Vec<String> {
+        sim.config
+            .walls
+            .iter()
+            .zip(&sim.wall_angle_rad)
+            .filter(|(w, angle)| w.is_plane() && facing(w.proximity(&centroid, **angle).normal.dot(&up)))
+            .map(|(w, _)| w.name.clone())
+            .collect()
+    };
+    const PARALLEL: f64 = 1e-9;
+    let columns: Vec<String> = match part {
+        NetForcePart::Fluid => vec!["fluid_force_up_n".into()],
+        NetForcePart::DistributorContact => walls(&|c| c > 1.0 - PARALLEL)
+            .iter()
+            .map(|w| format!("wall_{w}_contact_up_n"))
+            .collect(),
+        NetForcePart::DistributorCohesion => walls(&|c| c > 1.0 - PARALLEL)
+            .iter()
+            .map(|w| format!("wall_{w}_cohesion_up_n"))
+            .collect(),
+        NetForcePart::SidewallFriction => walls(&|c| c.abs() < PARALLEL)
+            .iter()
+            .flat_map(|w| [format!("wall_{w}_contact_up_n"), format!("wall_{w}_cohesion_up_n")])
+            .collect(),
+    };
+    let Some(columns) = columns
+        .iter()
+        .map(|c| series.column(c))
+        .collect::<Option<Vec<&[f64]>>>()
+    else {
+        return f64::NAN;
+    };
+    let (from, to) = levels[peak].window_s;
+    let ratios: Vec<f64> = (0..t.len())
+        .filter(|&k| t[k] >= from && t[k] < to)
+        .map(|k| columns.iter().map(|c| c[k]).sum::<f64>() / weight[k])
+        .collect();
+    if ratios.is_empty() { f64::NAN } else { mean(&ratios) }
 }
 
 /// u_mf of a run whose levels step the gas up: on the rising branch (from the slowest level on), the slowest level

@@ -100,6 +100,11 @@ impl Wall {
         matches!(self.shape, WallShape::Plane { normal, .. } if normal.x == 0.0 && normal.y == 0.0)
     }
 
+    /// A static plane (not a drum or a baffle).
+    pub fn is_plane(&self) -> bool {
+        matches!(self.shape, WallShape::Plane { .. })
+    }
+
     /// Angular velocity of the wall's rotation (0 for static walls).
     pub fn angular_velocity_rad_per_s(&self) -> f64 {
         match &self.shape {
