@@ -625,6 +625,10 @@ mod tests {
         state.contacts = ContactStore::default();
         state.cohesion.walls.clear();
         state.wall_angle_rad.clear();
+        if let Some(tally) = state.net_force.as_mut() {
+            tally.wall_contact_n.clear();
+            tally.wall_cohesion_n.clear();
+        }
         let meta = CheckpointMeta {
             wall_names: Vec::new(),
             model_names: Vec::new(),
@@ -632,6 +636,14 @@ mod tests {
             ..sample_meta()
         };
         round_trip(&state, &meta);
+    }
+
+    #[test]
+    fn a_state_without_gas_or_net_forces_round_trips() {
+        let mut state = sample_state();
+        state.gas = None;
+        state.net_force = None;
+        round_trip(&state, &sample_meta());
     }
 
     #[test]
@@ -1146,6 +1158,16 @@ mod tests {
             ds(&mut b, &format!("cohesion/{table}/bridge_volume_m3"), &[m], &volume);
             let in_well: Vec<u8> = c.iter().map(|x| u8::from(x.in_well)).collect();
             ds(&mut b, &format!("cohesion/{table}/in_well"), &[m], &in_well);
+        }
+        let tally = state.net_force.as_ref().expect("the sample records net forces");
+        let walls = tally.wall_contact_n.len();
+        ds(&mut b, "net_force/steps", &[1], &tally.steps.to_le_bytes());
+        ds(&mut b, "net_force/fluid_sum_n", &[1, 3], &f(tally.fluid_n.iter().copied()));
+        for (name, sums) in [
+            ("net_force/wall_contact_sum_n", &tally.wall_contact_n),
+            ("net_force/wall_cohesion_sum_n", &tally.wall_cohesion_n),
+        ] {
+            ds(&mut b, name, &[walls, 3], &f(sums.iter().flat_map(|v| v.iter().copied())));
         }
 
         assert_eq!(stored, xxhash_rust::xxh3::xxh3_64(&b));
