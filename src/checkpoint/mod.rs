@@ -1162,12 +1162,22 @@ mod tests {
         let tally = state.net_force.as_ref().expect("the sample records net forces");
         let walls = tally.wall_contact_n.len();
         ds(&mut b, "net_force/steps", &[1], &tally.steps.to_le_bytes());
-        ds(&mut b, "net_force/fluid_sum_n", &[1, 3], &f(tally.fluid_n.iter().copied()));
+        ds(
+            &mut b,
+            "net_force/fluid_sum_n",
+            &[1, 3],
+            &f(tally.fluid_n.iter().copied()),
+        );
         for (name, sums) in [
             ("net_force/wall_contact_sum_n", &tally.wall_contact_n),
             ("net_force/wall_cohesion_sum_n", &tally.wall_cohesion_n),
         ] {
-            ds(&mut b, name, &[walls, 3], &f(sums.iter().flat_map(|v| v.iter().copied())));
+            ds(
+                &mut b,
+                name,
+                &[walls, 3],
+                &f(sums.iter().flat_map(|v| v.iter().copied())),
+            );
         }
 
         assert_eq!(stored, xxhash_rust::xxh3::xxh3_64(&b));
