@@ -159,6 +159,9 @@ pub fn metrics(job: &JobSpec, built: &BuiltScenario, sim: &Simulation, series: &
         ))
     };
     let average_from_s = job.analysis.average_from_s.unwrap_or(0.5 * built.spec.time.end_time_s);
+    // The cycle is read once for all the cycle metrics that ask for it.
+    let cycle_once = std::cell::OnceCell::new();
+    let cycle = || cycle_once.get_or_init(|| cycle(job, built, sim, series)).as_ref();
     let mut out = Vec::new();
     for name in &job.metrics {
         let meta = info(name).ok_or_else(|| Error::External(format!("unknown metric `{name}`")))?;
@@ -202,25 +205,21 @@ pub fn metrics(job: &JobSpec, built: &BuiltScenario, sim: &Simulation, series: &
             }
             wet if wet.starts_with("granular_") || wet == "wet_phase_mixed" => wet_number(wet, job, built, sim),
             "coating_variability" => crate::engine::spray::coating_variability(&sim.particles.sprayed_m3),
-            "defluidization_velocity_m_per_s" => {
-                cycle(job, built, sim, series).map_or(f64::NAN, |c| c.defluidization_m_per_s)
-            }
+            "defluidization_velocity_m_per_s" => cycle().map_or(f64::NAN, |c| c.velocities.defluidization_m_per_s),
             "fluidization_velocity_theoretical_m_per_s" => {
-                cycle(job, built, sim, series).map_or(f64::NAN, |c| c.fluidization_theoretical_m_per_s)
+                cycle().map_or(f64::NAN, |c| c.velocities.fluidization_theoretical_m_per_s)
             }
-            "incipient_fluidization_velocity_m_per_s" => {
-                cycle(job, built, sim, series).map_or(f64::NAN, |c| c.incipient_m_per_s)
-            }
-            "pressure_overshoot_ratio" => cycle(job, built, sim, series).map_or(f64::NAN, |c| c.overshoot_ratio),
-            "overshoot_fluid_force_per_weight" => overshoot_net_force(NetForcePart::Fluid, job, built, sim, series),
+            "incipient_fluidization_velocity_m_per_s" => cycle().map_or(f64::NAN, |c| c.velocities.incipient_m_per_s),
+            "pressure_overshoot_ratio" => cycle().map_or(f64::NAN, |c| c.velocities.overshoot_ratio),
+            "overshoot_fluid_force_per_weight" => overshoot_net_force(NetForcePart::Fluid, cycle(), sim, series),
             "overshoot_distributor_contact_per_weight" => {
-                overshoot_net_force(NetForcePart::DistributorContact, job, built, sim, series)
+                overshoot_net_force(NetForcePart::DistributorContact, cycle(), sim, series)
             }
             "overshoot_distributor_cohesion_per_weight" => {
-                overshoot_net_force(NetForcePart::DistributorCohesion, job, built, sim, series)
+                overshoot_net_force(NetForcePart::DistributorCohesion, cycle(), sim, series)
             }
             "overshoot_sidewall_friction_per_weight" => {
-                overshoot_net_force(NetForcePart::SidewallFriction, job, built, sim, series)
+                overshoot_net_force(NetForcePart::SidewallFriction, cycle(), sim, series)
             }
             "stepped_fluidization_velocity_m_per_s" => stepped_onset_m_per_s(job, built, sim, series),
             other => return Err(Error::External(format!("metric `{other}` has no reducer"))),
@@ -394,24 +393,15 @@ fn level_stats(job: &JobSpec, built: &BuiltScenario, sim: &Simulation, series: &
     Some(stats)
 }
 
-/// Seed 001's cycle velocities from the level means ([`level_stats`]), each level's pressure drop over its weight
-/// per area (seed 001's ΔP* = ΔP/(W'/A_b)), so that the line meets 1.
-fn cycle(
-    job: &JobSpec,
-    built: &BuiltScenario,
-    sim: &Simulation,
-    series: &Series,
-) -> Option<analysis::fluidization::CycleVelocities> {
-    cycle_and_levels(job, built, sim, series).map(|(c, _)| c)
+/// Seed 001's cycle velocities and the levels they were read from.
+struct Cycle {
+    velocities: analysis::fluidization::CycleVelocities,
+    levels: Vec<LevelStats>,
 }
 
-/// [`cycle`] and the levels it was read from.
-fn cycle_and_levels(
-    job: &JobSpec,
-    built: &BuiltScenario,
-    sim: &Simulation,
-    series: &Series,
-) -> Option<(analysis::fluidization::CycleVelocities, Vec<LevelStats>)> {
+/// Seed 001's cycle velocities from the level means ([`level_stats`]), each level's pressure drop over its weight
+/// per area (seed 001's ΔP* = ΔP/(W'/A_b)), so that the line meets 1.
+fn cycle(job: &JobSpec, built: &BuiltScenario, sim: &Simulation, series: &Series) -> Option<Cycle> {
     let levels = level_stats(job, built, sim, series)?;
     let points: Vec<analysis::fluidization::CycleLevel> = levels
         .iter()
@@ -420,7 +410,10 @@ fn cycle_and_levels(
             pressure_drop_mean_pa: l.pressure_drop_mean_pa / l.weight_per_area_pa,
         })
         .collect();
-    (points.len() >= 3).then(|| (analysis::fluidization::cycle_velocities(&points, 1.0), levels))
+    (points.len() >= 3).then(|| Cycle {
+        velocities: analysis::fluidization::cycle_velocities(&points, 1.0),
+        levels,
+    })
 }
 
 /// Which mechanism of the net-force split (seed 001 Figs 8.8-8.16) an `overshoot_*_per_weight` metric reads.
@@ -435,18 +428,15 @@ enum NetForcePart {
 /// A net-force part over the weight, averaged over the second half of the cycle's overshoot peak level (the
 /// climb's top): the series' `*_up_n` columns over `weight_n`. The distributor is every plane wall whose normal
 /// points against gravity, the sidewalls every plane wall parallel to it (normals checked at the bed's centroid).
-fn overshoot_net_force(
-    part: NetForcePart,
-    job: &JobSpec,
-    built: &BuiltScenario,
-    sim: &Simulation,
-    series: &Series,
-) -> f64 {
-    let Some((cycle, levels)) = cycle_and_levels(job, built, sim, series) else {
+fn overshoot_net_force(part: NetForcePart, cycle: Option<&Cycle>, sim: &Simulation, series: &Series) -> f64 {
+    let Some(cycle) = cycle else {
         return f64::NAN;
     };
-    let (Some(peak), Some(t), Some(weight)) = (cycle.peak_level, series.column("time_s"), series.column("weight_n"))
-    else {
+    let (Some(peak), Some(t), Some(weight)) = (
+        cycle.velocities.peak_level,
+        series.column("time_s"),
+        series.column("weight_n"),
+    ) else {
         return f64::NAN;
     };
     let Some(up) = (-sim.config.gravity.at(sim.time_s)).try_normalize(0.0) else {
@@ -487,7 +477,7 @@ fn overshoot_net_force(
     else {
         return f64::NAN;
     };
-    let (from, to) = levels[peak].window_s;
+    let (from, to) = cycle.levels[peak].window_s;
     let ratios: Vec<f64> = (0..t.len())
         .filter(|&k| t[k] >= from && t[k] < to)
         .map(|k| columns.iter().map(|c| c[k]).sum::<f64>() / weight[k])
