@@ -151,12 +151,14 @@ impl Cohesion {
                 // One table per unordered pair (a ≤ b): j keeps what i does not.
                 for (ka, a) in species.species.iter().enumerate() {
                     for b in &species.species[ka..] {
+                        // Two species of the same radius and contact angle (e.g. identical beads in two colours)
+                        // are mirror images in a bridge: each keeps half, exactly, with no table to compute.
                         cohesion.rupture.push(RuptureTable::new(
                             a.radius_m,
                             b.radius_m,
                             a.contact_angle_deg.to_radians(),
                             b.contact_angle_deg.to_radians(),
-                            a == b,
+                            a.radius_m == b.radius_m && a.contact_angle_deg == b.contact_angle_deg,
                         ));
                         let (ta, tb) = (a.contact_angle_deg.to_radians(), b.contact_angle_deg.to_radians());
                         // Mikami's fit only where it is settled: equal particles at θ = 0 (B2).
@@ -233,8 +235,8 @@ const TABLE_DECADES: (i32, i32) = (-6, 0);
 const TABLE_PER_DECADE: usize = 10;
 
 impl RuptureTable {
-    fn new(radius_i_m: f64, radius_j_m: f64, angle_i_rad: f64, angle_j_rad: f64, same_species: bool) -> Self {
-        if same_species {
+    fn new(radius_i_m: f64, radius_j_m: f64, angle_i_rad: f64, angle_j_rad: f64, symmetric: bool) -> Self {
+        if symmetric {
             return RuptureTable {
                 radius_i_m,
                 shares: Vec::new(),
@@ -721,5 +723,44 @@ mod tests {
         // The more wettable particle (θ = 0) keeps more than its even share.
         assert!(table.share_of_i(1e-3 * ri * ri * ri) > 0.5);
         assert_eq!(RuptureTable::new(ri, ri, ti, ti, true).share_of_i(1e-9), 0.5);
+    }
+
+    /// Species that differ only in name or colour (seed 000's left/right beads) split a breaking bridge exactly in
+    /// half without computing a table (the symmetric bridge needs none); the computed table agrees to the
+    /// solver's rounding (to 1e-12: it is symmetric too).
+    #[test]
+    fn identical_beads_of_two_species_share_a_breaking_bridge_equally() {
+        use crate::engine::particles::{Species, SpeciesTable};
+        let bead = |name: &str| Species {
+            name: name.into(),
+            radius_m: 1.35e-3,
+            density_kg_per_m3: 2000.0,
+            youngs_modulus_pa: 1e7,
+            poisson_ratio: 0.33,
+            friction_coefficient: 0.3,
+            yield_force_n: None,
+            rolling_friction_coefficient: 0.0,
+            thermal_conductivity_w_per_m_k: None,
+            heat_capacity_j_per_kg_k: None,
+            contact_angle_deg: 0.0,
+            liquid_content: 0.01,
+        };
+        let species = SpeciesTable {
+            species: vec![bead("left"), bead("right")],
+        };
+        let model = CohesionModel::LiquidBridge(serde_norway::from_str("surface_tension_n_per_m: 0.02").unwrap());
+        let cohesion = Cohesion::new(model, &species, 1.35e-3).expect("valid cohesion");
+        let (left, right) = (SpeciesId(0), SpeciesId(1));
+        for v_hat in [1e-5, 1e-3, 0.02] {
+            let volume = v_hat * 1.35e-3f64.powi(3);
+            assert_eq!(cohesion.rupture_share_of_i(left, right, volume), 0.5);
+            assert_eq!(cohesion.rupture_share_of_i(right, left, volume), 0.5);
+        }
+        let (r, t) = (1.35e-3, 0.0);
+        let computed = RuptureTable::new(r, r, t, t, false);
+        for v_hat in [1e-4, 1e-3, 1e-2, 0.1] {
+            let share = computed.share_of_i(v_hat * r * r * r);
+            assert!((share - 0.5).abs() < 1e-12, "V̂ = {v_hat}: computed share {share}");
+        }
     }
 }
