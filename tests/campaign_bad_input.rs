@@ -352,7 +352,7 @@ const CASES: &[(&str, &str, &str, &[&str])] = &[
         "rotation_rpm",
         &[
             "key `sweep.grid[0].param`",
-            "no `rotation_rpm` at the top level (there: cohesion, contact, domain, fill, gas,",
+            "no `rotation_rpm` at the top level (there: cohesion, cohesion_off, contact, domain, fill, gas,",
         ],
     ),
     (
@@ -498,6 +498,27 @@ const CASES: &[(&str, &str, &str, &[&str])] = &[
             "key `metrics[4]`",
             "`overshoot_sidewall_friction_per_weight` needs a gas",
         ],
+    ),
+    (
+        "cohesion switched off without a cohesion model",
+        "  time: {",
+        "  cohesion_off: { between_particles: true }\n  time: {",
+        &["key `base.cohesion_off`", "expected a `cohesion` model to switch off"],
+    ),
+    (
+        "cohesion switched off at a wall that does not exist",
+        "  time: {",
+        "  cohesion: { hamaker: { constant_j: 1.0e-19, inner_cutoff_m: 4.0e-10, outer_cutoff_m: 1.0e-5 } }\n  cohesion_off: { walls: [drum, box_y_lo] }\n  time: {",
+        &[
+            "key `base.cohesion_off.walls[1]`",
+            "no wall named 'box_y_lo'; the walls are: drum",
+        ],
+    ),
+    (
+        "cohesion switched off at a wall it does not act on",
+        "  time: {",
+        "  cohesion: { hamaker: { constant_j: 1.0e-19, inner_cutoff_m: 4.0e-10, outer_cutoff_m: 1.0e-5, walls: false } }\n  cohesion_off: { walls: [drum] }\n  time: {",
+        &["key `base.cohesion_off.walls[0]`", "does not act on walls"],
     ),
     (
         "net_forces not a boolean",

@@ -291,6 +291,69 @@ fn the_net_forces_by_mechanism_close_the_momentum_balance_of_a_cohesive_bed() {
     );
 }
 
+/// `cohesion_off` switches the model off exactly where it says (seed 001 ch. 8's exclusion runs): a Hamaker bed
+/// landing on the distributor (within its 3000 steps) with the cohesion off between particles and at the distributor has nothing left to
+/// feel (the top wall is out of reach, the front and back planes act along z only), so it ends bit for bit as the
+/// same bed without cohesion; with only the distributor off, the particles still attract each other, and with only
+/// the particles off, the distributor still pulls.
+#[test]
+fn cohesion_switched_off_between_particles_and_at_the_distributor_leaves_a_dry_bed() {
+    let tmp = tempfile::tempdir().expect("temp dir");
+    let dir = tmp.path();
+    let landing = |extra: &str| {
+        bed(0.03, extra)
+            .replace("spacing_m: 0.003", "spacing_m: 0.0027")
+            .replace(
+                "origin_m: [0.0015, 0.0015, 0.00135]",
+                "origin_m: [0.00135, 0.00135, 0.00135]",
+            )
+            .replace("superficial_velocity_m_per_s: 2.5", "superficial_velocity_m_per_s: 1.0")
+    };
+    let cases = [
+        ("dry", String::new()),
+        (
+            "off",
+            format!("{HAMAKER_WITH_WALLS}\ncohesion_off: {{ between_particles: true, walls: [box_y_lo] }}"),
+        ),
+        (
+            "distributor-off",
+            format!("{HAMAKER_WITH_WALLS}\ncohesion_off: {{ walls: [box_y_lo] }}"),
+        ),
+        (
+            "particles-off",
+            format!("{HAMAKER_WITH_WALLS}\ncohesion_off: {{ between_particles: true }}"),
+        ),
+    ];
+    let mut states = Vec::new();
+    for (name, extra) in &cases {
+        std::fs::write(dir.join(format!("{name}.yaml")), landing(extra)).unwrap();
+        run_ok(&["simulate", &format!("{name}.yaml"), "--out", name, "--quiet"], dir);
+        states.push(final_state(&dir.join(name)));
+    }
+    let bits = |s: &SimState| -> Vec<u64> {
+        let p = &s.particles;
+        p.position_m
+            .iter()
+            .chain(&p.velocity_m_per_s)
+            .chain(&p.angular_velocity_rad_per_s)
+            .flat_map(|v| v.iter().map(|a| a.to_bits()).collect::<Vec<_>>())
+            .collect()
+    };
+    assert_eq!(states[0].step, 3000);
+    assert!(
+        bits(&states[0]) == bits(&states[1]),
+        "cohesion switched off everywhere it reaches changed the bed"
+    );
+    assert!(
+        bits(&states[0]) != bits(&states[2]),
+        "particle–particle cohesion was switched off too"
+    );
+    assert!(
+        bits(&states[0]) != bits(&states[3]),
+        "the distributor's cohesion was switched off too"
+    );
+}
+
 /// A run interrupted by one granflow and resumed by another that writes other series columns is refused with the
 /// file named, and its series is left as it was (not cut down to the rows that fit the new header).
 #[test]

@@ -43,6 +43,10 @@ pub struct Cohesion {
     /// Liquid bridges: the Young–Laplace force table per unordered species pair (indexed as `rupture`), or `None`
     /// where Mikami's fit applies (equal radii and both contact angles 0, with `capillary_force: auto`).
     pub capillary: Vec<Option<CapillaryTable>>,
+    /// The model acts between particles (scenario `cohesion_off.between_particles` switches it off).
+    pub between_particles: bool,
+    /// Per wall: the model acts on it (empty: on every wall when `wall_range_m` > 0; `cohesion_off.walls`).
+    pub wall_on: Vec<bool>,
     n_species: usize,
 }
 
@@ -76,6 +80,8 @@ impl Cohesion {
             contact_angle_rad,
             rupture: Vec::new(),
             capillary: Vec::new(),
+            between_particles: true,
+            wall_on: Vec::new(),
             n_species: n,
         };
         match model {
@@ -493,7 +499,12 @@ pub fn apply_cohesion(
             p.mass_kg[i],
             p.species[i],
         );
-        for k in list.pairs_of(i) {
+        let pairs = if cohesion.between_particles {
+            list.pairs_of(i)
+        } else {
+            0..0
+        };
+        for k in pairs {
             let j = list.partner[k] as usize;
             let d = config.domain.separation(&xi, &p.position_m[j]);
             let (rj, mj, sj) = (p.radius_m[j], p.mass_kg[j], p.species[j]);
@@ -611,6 +622,9 @@ pub fn apply_cohesion(
         if cohesion.wall_range_m > 0.0 {
             for k in list.walls_of(i) {
                 let w = list.wall_partner[k] as usize;
+                if !cohesion.wall_on.get(w).copied().unwrap_or(true) {
+                    continue;
+                }
                 let prox = config.walls[w].proximity(&xi, wall_angle_rad[w]);
                 let gap = prox.gap_m - ri;
                 let slot = &mut state.wall[k];

@@ -232,12 +232,33 @@ pub fn build(spec: ScenarioSpec, path: &Path) -> Result<BuiltScenario, ConfigErr
             )?)
         }
     };
-    let cohesion = match spec.cohesion {
+    let mut cohesion = match spec.cohesion {
         None => None,
         Some(model) => Some(
             Cohesion::new(model, &species, particles.max_radius_m()).map_err(|(key, message)| c.fail(key, message))?,
         ),
     };
+    if let Some(off) = &spec.cohesion_off {
+        let Some(cohesion) = cohesion.as_mut() else {
+            return Err(c.fail("cohesion_off", "expected a `cohesion` model to switch off"));
+        };
+        cohesion.between_particles = !off.between_particles;
+        cohesion.wall_on = vec![cohesion.wall_range_m > 0.0; walls.len()];
+        for (k, name) in off.walls.iter().enumerate() {
+            let key = format!("cohesion_off.walls[{k}]");
+            if cohesion.wall_range_m <= 0.0 {
+                return Err(c.fail(key, "the cohesion model does not act on walls (its `walls` is false)"));
+            }
+            let Some(w) = walls.iter().position(|w| &w.name == name) else {
+                let names: Vec<&str> = walls.iter().map(|w| w.name.as_str()).collect();
+                return Err(c.fail(
+                    key,
+                    format!("no wall named '{name}'; the walls are: {}", names.join(", ")),
+                ));
+            };
+            cohesion.wall_on[w] = false;
+        }
+    }
     if !matches!(spec.cohesion, Some(CohesionModel::LiquidBridge(_)))
         && let Some(k) = spec.species.iter().position(|s| s.liquid_content != 0.0)
     {

@@ -41,6 +41,23 @@ pub struct ScenarioSpec {
     /// dry, cohesionless particles.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub cohesion: Option<crate::engine::models::cohesion_law::CohesionModel>,
+    /// Interactions the cohesion model is switched off for (seed 001 ch. 8's exclusion runs: no particle–particle,
+    /// no particle–sidewall or no particle–distributor cohesion); absent: none.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub cohesion_off: Option<CohesionOff>,
+}
+
+/// What `cohesion_off` switches the cohesion model off for.
+#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize, schemars::JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct CohesionOff {
+    /// No cohesion between particles (default false).
+    #[serde(default)]
+    pub between_particles: bool,
+    /// Walls, by name (`box_x_lo` … `box_z_hi` for a box), that particles feel no cohesion from; the model must act
+    /// on walls (its `walls: true`).
+    #[serde(default)]
+    pub walls: Vec<String>,
 }
 
 fn default_max_overlap_fraction() -> f64 {
