@@ -92,7 +92,7 @@ pub fn status(dir: &Path) -> Result<String, Error> {
     );
     let jobs_by_id: std::collections::HashMap<&str, &campaign::JobSpec> =
         campaign.jobs.iter().map(|j| (j.job_id.as_str(), j)).collect();
-    let label = |id: &str| jobs_by_id.get(id).map(|j| j.label()).unwrap_or_default();
+    let label = |id: &str| jobs_by_id.get(id).map(|j| campaign.label(j)).unwrap_or_default();
     for r in rows.iter().filter(|r| r.status == JobStatus::Running) {
         let end = jobs_by_id
             .get(r.job_id.as_str())
