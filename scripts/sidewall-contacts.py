@@ -23,7 +23,12 @@ rows = db.execute("SELECT job_id, params_json FROM jobs WHERE status = 'done' OR
 
 
 def label(params):
-    c = json.loads(params).get("cohesion")
+    params = json.loads(params)
+    off = params.get("cohesion_off")
+    if off is not None:
+        parts = (["particles"] if off.get("between_particles") else []) + off.get("walls", [])
+        return "off: " + " ".join(parts)
+    c = params.get("cohesion")
     if not c:
         return "dry"
     (model, p), = c.items()
@@ -43,7 +48,7 @@ def single_file(heights, radius):
     return run
 
 
-print(f"{'cohesion':<22} {'job':<17} {'t (s)':>5}  {'x_lo':>4} {'file':>4}  {'x_hi':>4} {'file':>4}  {'top (mm)':>8}")
+print(f"{'case':<22} {'job':<17} {'t (s)':>5}  {'x_lo':>4} {'file':>4}  {'x_hi':>4} {'file':>4}  {'top (mm)':>8}")
 for job_id, params in rows:
     for path in sorted(glob.glob(os.path.join(args.dir, "jobs", job_id, "ckpt-*.h5"))):
         with h5py.File(path, "r") as f:
