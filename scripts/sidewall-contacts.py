@@ -6,6 +6,7 @@ up with centres one diameter apart (within 1 %). A diagnostic for D8's sidewall-
 
     pip install h5py numpy
     scripts/sidewall-contacts.py results/d8-cohesion-beds
+    scripts/sidewall-contacts.py results/d8-hamaker-wall-rolling --walls 2 3   # walls given as planes
 
 Prints one line per job and checkpoint: contacts on each sidewall, the single-file run on each, the bed's highest
 wall contact."""
@@ -16,6 +17,8 @@ import numpy as np
 
 ap = argparse.ArgumentParser()
 ap.add_argument("dir")
+ap.add_argument("--walls", type=int, nargs=2, default=[0, 1],
+                help="indices of the two sidewalls in the scenario's wall list (a box's x walls are 0 and 1)")
 args = ap.parse_args()
 
 db = sqlite3.connect(os.path.join(args.dir, "campaign.sqlite"))
@@ -28,7 +31,9 @@ def label(params):
     if off is not None:
         parts = (["particles"] if off.get("between_particles") else []) + off.get("walls", [])
         return "off: " + " ".join(parts)
-    c = params.get("cohesion")
+    if "cohesion" not in params:
+        return ", ".join(f"{k.rsplit('.', 1)[-1]}={v}" for k, v in params.items() if k != "seed")[:22]
+    c = params["cohesion"]
     if not c:
         return "dry"
     (model, p), = c.items()
@@ -58,8 +63,8 @@ for job_id, params in rows:
             radius = float(np.median(f["particles/radius_m"][:]))
             time_s = float(f["gas/time_s"][0]) if "gas/time_s" in f else float("nan")
             out = []
-            for w in (0, 1):  # box_x_lo, box_x_hi: the walls normal to x
+            for w in args.walls:
                 sel = who[wall == w]
                 out += [len(sel), single_file(x[sel, 1], radius)]
-            top = 1000 * x[who[np.isin(wall, (0, 1))], 1].max() if np.isin(wall, (0, 1)).any() else 0.0
+            top = 1000 * x[who[np.isin(wall, args.walls)], 1].max() if np.isin(wall, args.walls).any() else 0.0
             print(f"{label(params):<22} {job_id:<17} {time_s:5.2f}  {out[0]:4d} {out[1]:4d}  {out[2]:4d} {out[3]:4d}  {top:8.1f}")
