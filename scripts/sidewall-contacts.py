@@ -32,7 +32,7 @@ def label(params):
         parts = (["particles"] if off.get("between_particles") else []) + off.get("walls", [])
         return "off: " + " ".join(parts)
     if "cohesion" not in params:
-        return ", ".join(f"{k.rsplit('.', 1)[-1]}={v}" for k, v in params.items() if k != "seed")[:22]
+        return ", ".join(f"{k.rsplit('.', 1)[-1][:12]}={v}" for k, v in params.items() if k != "seed")
     c = params["cohesion"]
     if not c:
         return "dry"
