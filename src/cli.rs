@@ -79,6 +79,10 @@ pub enum Command {
         pivot: Option<Vec<String>>,
         #[arg(long)]
         metric: Option<String>,
+        /// With --pivot: only jobs whose parameter has this value (repeatable), e.g. `--where radius_m=0.00135`
+        /// to take one particle kind of several instead of averaging over them.
+        #[arg(long = "where", value_name = "PARAM=VALUE", requires = "pivot")]
+        filters: Vec<String>,
         /// Any read-only SQL over the tables of schemas/results.sql.
         #[arg(long)]
         sql: Option<String>,
@@ -343,13 +347,19 @@ pub fn run(cli: Cli) -> Result<i32> {
             dir,
             pivot,
             metric,
+            filters,
             sql,
             format,
         } => {
             let text = match (pivot, sql) {
-                (Some(axes), None) => {
-                    inspect::pivot(&dir, &axes[0], &axes[1], metric.as_deref().unwrap_or_default(), format)?
-                }
+                (Some(axes), None) => inspect::pivot(
+                    &dir,
+                    &axes[0],
+                    &axes[1],
+                    metric.as_deref().unwrap_or_default(),
+                    &filters,
+                    format,
+                )?,
                 (None, Some(sql)) => inspect::sql(&dir, &sql, format)?,
                 _ => {
                     return Err(crate::Error::Usage(

@@ -165,10 +165,23 @@ fn resolve_param(store: &Store, name: &str) -> Result<String, Error> {
 }
 
 /// `granflow query --pivot X Y --metric M`.
-pub fn pivot(dir: &Path, x: &str, y: &str, metric: &str, format: Format) -> Result<String, Error> {
+pub fn pivot(dir: &Path, x: &str, y: &str, metric: &str, filters: &[String], format: Format) -> Result<String, Error> {
     let (store, id, _) = open(dir)?;
     let (x, y) = (resolve_param(&store, x)?, resolve_param(&store, y)?);
-    let p = store.pivot(id, &x, &y, metric).map_err(store_err)?;
+    let mut wanted = Vec::new();
+    for filter in filters {
+        let Some((name, value)) = filter.split_once('=') else {
+            return Err(Error::External(format!(
+                "--where `{filter}`: expected PARAM=VALUE, e.g. radius_m=0.00135"
+            )));
+        };
+        let value = match value.trim().parse::<f64>() {
+            Ok(v) => store::ParamValue::Real(v),
+            Err(_) => store::ParamValue::Text(value.trim().to_string()),
+        };
+        wanted.push((resolve_param(&store, name.trim())?, value));
+    }
+    let p = store.pivot_where(id, &x, &y, metric, &wanted).map_err(store_err)?;
     Ok(match format {
         Format::Table => p.to_table(),
         Format::Csv => p.to_csv(),

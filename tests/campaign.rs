@@ -124,6 +124,27 @@ fn a_campaign_runs_stores_every_job_and_pivots() {
         }
     }
 
+    // --where keeps one speed's jobs: its column filled, the other's empty.
+    let filtered = ok(
+        &[
+            "query",
+            out.to_str().unwrap(),
+            "--pivot",
+            "rotation_rpm",
+            "fill_top_m",
+            "--metric",
+            "lacey_index",
+            "--where",
+            "rotation_rpm=20",
+            "--format",
+            "csv",
+        ],
+        tmp.path(),
+    );
+    for row in filtered.lines().skip(1) {
+        let cells: Vec<&str> = row.split(',').collect();
+        assert!(!cells[1].is_empty() && cells[2].is_empty(), "{filtered}");
+    }
     let export = ok(&["export", out.to_str().unwrap(), "--format", "csv"], tmp.path());
     assert_eq!(export.lines().count(), 5, "{export}");
     let status = ok(&["status", out.to_str().unwrap()], tmp.path());

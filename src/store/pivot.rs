@@ -39,6 +39,8 @@ pub struct Pivot {
     pub y_values: Vec<ParamValue>,
     /// `cells[row][column]`, indexed like `y_values` and `x_values`; `None` where no done job has a value.
     pub cells: Vec<Vec<Option<PivotCell>>>,
+    /// Only jobs with these parameter values were laid out (empty: all).
+    pub filters: Vec<(String, ParamValue)>,
 }
 
 impl Store {
@@ -46,6 +48,20 @@ impl Store {
     /// parameter or metric names fail with the list of names that exist; jobs lacking either parameter are left
     /// out.
     pub fn pivot(&self, campaign_id: i64, x_param: &str, y_param: &str, metric: &str) -> Result<Pivot, StoreError> {
+        self.pivot_where(campaign_id, x_param, y_param, metric, &[])
+    }
+
+    /// [`Store::pivot`] of only the jobs whose parameters have the given values (e.g. one particle kind of several:
+    /// otherwise a cell averages over them). A filter on a parameter the campaign does not sweep fails with the list
+    /// of those it does; a value no job has leaves every cell empty.
+    pub fn pivot_where(
+        &self,
+        campaign_id: i64,
+        x_param: &str,
+        y_param: &str,
+        metric: &str,
+        filters: &[(String, ParamValue)],
+    ) -> Result<Pivot, StoreError> {
         self.require_campaign(campaign_id)?;
         if x_param == y_param {
             return Err(StoreError::InvalidQuery {
@@ -62,7 +78,10 @@ impl Store {
                 params![campaign_id],
             )
             .context(&self.path, &action)?;
-        for name in [x_param, y_param] {
+        for name in [x_param, y_param]
+            .into_iter()
+            .chain(filters.iter().map(|(name, _)| name.as_str()))
+        {
             if !parameters.iter().any(|known| known == name) {
                 return Err(StoreError::UnknownParameter {
                     path: self.path.clone(),
@@ -108,8 +127,25 @@ impl Store {
         let points = self
             .pivot_points(campaign_id, x_param, y_param, metric)
             .context(&self.path, &action)?;
+        let mut kept: Option<std::collections::HashSet<String>> = None;
+        for (name, wanted) in filters {
+            let matching: std::collections::HashSet<String> = self
+                .job_values(campaign_id, name)
+                .context(&self.path, &action)?
+                .into_iter()
+                .filter(|(_, value)| value.axis_cmp(wanted) == Ordering::Equal)
+                .map(|(job, _)| job)
+                .collect();
+            kept = Some(match kept {
+                None => matching,
+                Some(k) => k.intersection(&matching).cloned().collect(),
+            });
+        }
         let mut sums = vec![vec![(0.0, 0usize); x_values.len()]; y_values.len()];
-        for (x, y, value) in points {
+        for (job, x, y, value) in points {
+            if kept.as_ref().is_some_and(|k| !k.contains(&job)) {
+                continue;
+            }
             // Every point's values are on the axes, which list all values of the campaign.
             let column = x_values.binary_search_by(|probe| probe.axis_cmp(&x));
             let row = y_values.binary_search_by(|probe| probe.axis_cmp(&y));
@@ -139,10 +175,24 @@ impl Store {
             x_values,
             y_values,
             cells,
+            filters: filters.to_vec(),
         })
     }
 
-    /// (x value, y value, metric value) of every done job of the campaign that has both parameters and a non-NULL
+    /// (job id, value) of parameter `name` for every job of the campaign that has it.
+    fn job_values(&self, campaign_id: i64, name: &str) -> rusqlite::Result<Vec<(String, ParamValue)>> {
+        let mut stmt = self.conn.prepare_cached(
+            "SELECT p.job_id, p.value_real, p.value_text FROM params p JOIN jobs j ON j.job_id = p.job_id
+             WHERE j.campaign_id = ?1 AND p.name = ?2",
+        )?;
+        let rows = stmt.query_map(params![campaign_id, name], |row| {
+            let job: String = row.get(0)?;
+            Ok(ParamValue::from_columns(row.get(1)?, row.get(2)?).map(|v| (job, v)))
+        })?;
+        rows.filter_map(Result::transpose).collect()
+    }
+
+    /// (job id, x value, y value, metric value) of every done job of the campaign that has both parameters and a non-NULL
     /// value of the metric.
     fn pivot_points(
         &self,
@@ -150,9 +200,9 @@ impl Store {
         x_param: &str,
         y_param: &str,
         metric: &str,
-    ) -> rusqlite::Result<Vec<(ParamValue, ParamValue, f64)>> {
+    ) -> rusqlite::Result<Vec<(String, ParamValue, ParamValue, f64)>> {
         let mut stmt = self.conn.prepare_cached(
-            "SELECT px.value_real, px.value_text, py.value_real, py.value_text, m.value
+            "SELECT px.value_real, px.value_text, py.value_real, py.value_text, m.value, j.job_id
              FROM jobs j
              JOIN params px ON px.job_id = j.job_id AND px.name = ?2
              JOIN params py ON py.job_id = j.job_id AND py.name = ?3
@@ -163,7 +213,8 @@ impl Store {
             let x = ParamValue::from_columns(row.get(0)?, row.get(1)?);
             let y = ParamValue::from_columns(row.get(2)?, row.get(3)?);
             let value: f64 = row.get(4)?;
-            Ok(x.zip(y).map(|(x, y)| (x, y, value)))
+            let job: String = row.get(5)?;
+            Ok(x.zip(y).map(|(x, y)| (job, x, y, value)))
         })?;
         rows.filter_map(Result::transpose).collect()
     }
@@ -224,6 +275,14 @@ impl Pivot {
             self.y_param,
             self.x_param
         );
+        if !self.filters.is_empty() {
+            let conditions: Vec<String> = self
+                .filters
+                .iter()
+                .map(|(name, value)| format!("{name} = {value}"))
+                .collect();
+            out.push_str(&format!("only jobs with {}\n", conditions.join(", ")));
+        }
         if self.has_averaged_cells() {
             out.push_str("(n=K): mean over K jobs that differ in other parameters\n");
         }
@@ -285,6 +344,7 @@ impl Pivot {
             "y_values": self.y_values.iter().map(ParamValue::to_json).collect::<Value>(),
             "mean": matrix(&|cell| cell.map_or(Value::Null, |cell| json_real(cell.mean))),
             "count": matrix(&|cell| Value::from(cell.map_or(0, |cell| cell.count))),
+            "where": self.filters.iter().map(|(name, value)| (name.clone(), value.to_json())).collect::<serde_json::Map<_, _>>(),
         });
         format!("{object}\n")
     }
@@ -374,6 +434,36 @@ mod tests {
         assert_eq!(pivot.cells, vec![vec![None, Some(PivotCell { mean: 1.5, count: 2 })]]);
         assert!(pivot.to_table().contains("1.5 (n=2)"));
         assert!(pivot.to_table().contains("(n=K): mean over K jobs"));
+
+        // Filtered to one seed, the cell is that job's alone; the axes still list every value.
+        let one_seed = [("seed".to_string(), ParamValue::Real(2.0))];
+        let pivot = store.pivot_where(campaign, "u", "fill", "k", &one_seed).unwrap();
+        assert_eq!(pivot.x_values, [ParamValue::Real(9.0), ParamValue::Real(10.0)]);
+        assert_eq!(pivot.cells, vec![vec![None, Some(PivotCell { mean: 2.0, count: 1 })]]);
+        assert!(
+            pivot.to_table().contains("only jobs with seed = 2\n"),
+            "{}",
+            pivot.to_table()
+        );
+        let json: Value = serde_json::from_str(&pivot.to_json()).unwrap();
+        assert_eq!(json["where"], json!({ "seed": 2.0 }));
+        // Two filters intersect; a value no job has empties every cell; an unswept parameter is an error.
+        let both = [one_seed[0].clone(), ("u".to_string(), ParamValue::Real(9.0))];
+        let pivot = store.pivot_where(campaign, "u", "fill", "k", &both).unwrap();
+        assert_eq!(pivot.cells, vec![vec![None, None]]);
+        let err = store
+            .pivot_where(
+                campaign,
+                "u",
+                "fill",
+                "k",
+                &[("colour".to_string(), ParamValue::Real(1.0))],
+            )
+            .unwrap_err();
+        assert!(
+            matches!(&err, StoreError::UnknownParameter { name, .. } if name == "colour"),
+            "{err}"
+        );
     }
 
     #[test]
