@@ -95,8 +95,9 @@ fn a_campaign_runs_stores_every_job_and_pivots() {
         );
     }
 
-    let pivot = ok(
-        &[
+    // The Lacey index over speed and fill level as CSV, with `filters` (e.g. `--where PARAM=VALUE`).
+    let lacey_pivot = |filters: &[&str]| {
+        let mut args = vec![
             "query",
             out.to_str().unwrap(),
             "--pivot",
@@ -106,9 +107,11 @@ fn a_campaign_runs_stores_every_job_and_pivots() {
             "lacey_index",
             "--format",
             "csv",
-        ],
-        tmp.path(),
-    );
+        ];
+        args.extend_from_slice(filters);
+        ok(&args, tmp.path())
+    };
+    let pivot = lacey_pivot(&[]);
     let lines: Vec<&str> = pivot.lines().collect();
     assert_eq!(lines.len(), 3, "a header and one row per fill level:\n{pivot}");
     assert!(lines[0].contains("20") && lines[0].contains("60"), "{pivot}");
@@ -125,22 +128,7 @@ fn a_campaign_runs_stores_every_job_and_pivots() {
     }
 
     // --where keeps one speed's jobs: its column filled, the other's empty.
-    let filtered = ok(
-        &[
-            "query",
-            out.to_str().unwrap(),
-            "--pivot",
-            "rotation_rpm",
-            "fill_top_m",
-            "--metric",
-            "lacey_index",
-            "--where",
-            "rotation_rpm=20",
-            "--format",
-            "csv",
-        ],
-        tmp.path(),
-    );
+    let filtered = lacey_pivot(&["--where", "rotation_rpm=20"]);
     for row in filtered.lines().skip(1) {
         let cells: Vec<&str> = row.split(',').collect();
         assert!(!cells[1].is_empty() && cells[2].is_empty(), "{filtered}");
