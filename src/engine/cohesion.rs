@@ -746,18 +746,8 @@ mod tests {
     fn identical_beads_of_two_species_share_a_breaking_bridge_equally() {
         use crate::engine::particles::{Species, SpeciesTable};
         let bead = |name: &str| Species {
-            name: name.into(),
-            radius_m: 1.35e-3,
-            density_kg_per_m3: 2000.0,
-            youngs_modulus_pa: 1e7,
-            poisson_ratio: 0.33,
-            friction_coefficient: 0.3,
-            yield_force_n: None,
-            rolling_friction_coefficient: 0.0,
-            thermal_conductivity_w_per_m_k: None,
-            heat_capacity_j_per_kg_k: None,
-            contact_angle_deg: 0.0,
             liquid_content: 0.01,
+            ..Species::test_bead(name, 1.35e-3, 2000.0)
         };
         let species = SpeciesTable {
             species: vec![bead("left"), bead("right")],

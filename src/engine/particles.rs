@@ -70,6 +70,27 @@ impl Species {
     }
 }
 
+#[cfg(test)]
+impl Species {
+    /// A dry bead (E = 1e7 Pa, ν = 0.3, μ = 0.3, nothing else set) for unit tests.
+    pub fn test_bead(name: &str, radius_m: f64, density_kg_per_m3: f64) -> Species {
+        Species {
+            name: name.into(),
+            radius_m,
+            density_kg_per_m3,
+            youngs_modulus_pa: 1e7,
+            poisson_ratio: 0.3,
+            friction_coefficient: 0.3,
+            yield_force_n: None,
+            rolling_friction_coefficient: 0.0,
+            thermal_conductivity_w_per_m_k: None,
+            heat_capacity_j_per_kg_k: None,
+            contact_angle_deg: 0.0,
+            liquid_content: 0.0,
+        }
+    }
+}
+
 /// All species of a simulation, indexed by [`SpeciesId`].
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize, Default, schemars::JsonSchema)]
 pub struct SpeciesTable {

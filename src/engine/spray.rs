@@ -70,20 +70,7 @@ mod tests {
     use crate::engine::particles::{Species, SpeciesId};
 
     fn bead() -> Species {
-        Species {
-            name: "s".into(),
-            radius_m: 0.001,
-            density_kg_per_m3: 1000.0,
-            youngs_modulus_pa: 1e7,
-            poisson_ratio: 0.3,
-            friction_coefficient: 0.3,
-            yield_force_n: None,
-            rolling_friction_coefficient: 0.0,
-            thermal_conductivity_w_per_m_k: None,
-            heat_capacity_j_per_kg_k: None,
-            contact_angle_deg: 0.0,
-            liquid_content: 0.0,
-        }
+        Species::test_bead("s", 0.001, 1000.0)
     }
 
     /// Two columns of three beads under gravity along −z: only the top bead of each column is sprayed, up to the
