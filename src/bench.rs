@@ -297,13 +297,14 @@ pub fn bench_dem(opts: &DemBenchOptions) -> Result<()> {
     };
     let heap = sim.heap_bytes();
     println!(
-        "granflow: {} particles, {} steps, {} thread(s): loop time {:.2} s, {:.4e} particle-steps/s, {} neighbour-list builds",
+        "granflow: {} particles, {} steps, {} thread(s): loop time {:.2} s, {:.4e} particle-steps/s, {} neighbour-list builds (cell searches) and {} refilters of the force pass's list",
         ours.particles,
         ours.steps,
         sim.threads(),
         ours.loop_time_s,
         ours.particle_steps_per_s(),
-        sim.neighbor_builds()
+        sim.neighbor_builds(),
+        sim.neighbor_refilters()
     );
     if let Some((one, difference)) = &one_thread {
         println!(
@@ -325,8 +326,9 @@ pub fn bench_dem(opts: &DemBenchOptions) -> Result<()> {
     }
     let (pair_contacts, wall_contacts) = sim.contact_counts();
     println!(
-        "granflow: at the end: {:.2} candidate pairs, {:.2} particle contacts and {:.3} wall contacts per particle",
+        "granflow: at the end: {:.2} candidate pairs in the force pass's list (inner skin {} mm), {:.2} particle contacts and {:.3} wall contacts per particle",
         sim.candidate_pairs() as f64 / ours.particles as f64,
+        sim.config.inner_skin_m * 1e3,
         pair_contacts as f64 / ours.particles as f64,
         wall_contacts as f64 / ours.particles as f64
     );

@@ -49,8 +49,11 @@ pub struct Summary {
     pub resumed_from_step: Option<u64>,
     /// This invocation's wall time per engine stage, seconds (see `Simulation::stage_timings`).
     pub stage_timings_s: Vec<(String, f64)>,
-    /// Neighbour-list builds in this invocation.
+    /// Neighbour-list builds (cell searches) in this invocation.
     pub neighbor_builds: u64,
+    /// Refilters of the force pass's list from the candidates (the two-level scheme) in this invocation.
+    #[serde(default)]
+    pub neighbor_refilters: u64,
 }
 
 const SERIES_HEADER: &str = "step,time_s,kinetic_energy_j,translational_kinetic_energy_j,bed_top_m,mean_height_m,pair_contacts,wall_contacts,mean_coordination";
@@ -521,6 +524,7 @@ pub fn run_in_dir(built: &BuiltScenario, out: &Path, ctl: RunControl) -> Result<
         resumed_from_step,
         stage_timings_s: sim.stage_timings(),
         neighbor_builds: sim.neighbor_builds(),
+        neighbor_refilters: sim.neighbor_refilters(),
     };
     if summary.finished {
         let json = serde_json::to_string_pretty(&summary).expect("summary serialises");

@@ -41,6 +41,12 @@ const CASES: &[(&str, &str, &str, &[&str])] = &[
         &["missing field `end_time_s`"],
     ),
     (
+        "inner skin larger than the skin",
+        "time: { dt_s: 1.0e-5, end_time_s: 0.001 }",
+        "time: { dt_s: 1.0e-5, end_time_s: 0.001 }\nneighbor: { skin_m: 0.0004, inner_skin_m: 0.0005 }",
+        &["bad.yaml", "neighbor.inner_skin_m", "<= neighbor.skin_m"],
+    ),
+    (
         "negative radius",
         "radius_m: 0.001",
         "radius_m: -0.001",

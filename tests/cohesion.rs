@@ -106,6 +106,41 @@ fn b4_liquid_is_conserved_while_bridges_form_and_break() {
     assert!(!s.cohesion.walls.is_empty(), "bridges to the drum stand");
 }
 
+/// Bridges survive the two-level neighbour list's refilters: the wet drum ends with the same bits with the force
+/// pass's list refiltered from the candidates as with a single list.
+#[test]
+fn a_wet_drum_gives_the_same_bits_with_one_or_two_neighbour_list_levels() {
+    let mut single = simulation(
+        &built(&format!(
+            "{WET_DRUM}neighbor: {{ skin_m: 0.0006, inner_skin_m: 0.0006 }}\n"
+        )),
+        1,
+    );
+    let mut refiltered = simulation(
+        &built(&format!(
+            "{WET_DRUM}neighbor: {{ skin_m: 0.0006, inner_skin_m: 0.00015 }}\n"
+        )),
+        1,
+    );
+    single.run_steps(3000).expect("stable");
+    refiltered.run_steps(3000).expect("stable");
+    let events = refiltered.cohesion_events;
+    println!(
+        "two levels: {} builds + {} refilters; {} bridges formed, {} broken",
+        refiltered.neighbor_builds(),
+        refiltered.neighbor_refilters(),
+        events.bridges_formed,
+        events.bridges_ruptured
+    );
+    assert!(
+        refiltered.neighbor_refilters() > 10 && events.bridges_ruptured > 100,
+        "{events:?}"
+    );
+    if let Some(diff) = first_difference(&single.snapshot(), &refiltered.snapshot()) {
+        panic!("the two-level list changes the wet drum: {diff}");
+    }
+}
+
 fn final_state(dir: &Path) -> SimState {
     let series = CheckpointSeries::new(dir, 2);
     series

@@ -228,3 +228,33 @@ fn fused_and_unfused_stepping_are_bit_identical() {
         }
     }
 }
+
+/// The two-level neighbour list (the force pass's list refiltered from the candidates within the skin) and a single
+/// list give the same bits: the list only decides which pairs are examined, never their order.
+#[test]
+fn two_level_and_single_neighbour_lists_are_bit_identical() {
+    let one_level = built(&format!("{DRUM}neighbor: {{ skin_m: 0.0006, inner_skin_m: 0.0006 }}\n"));
+    let two_level = built(&format!(
+        "{DRUM}neighbor: {{ skin_m: 0.0006, inner_skin_m: 0.00015 }}\n"
+    ));
+    for threads in [1, 2] {
+        let mut single = simulation(&one_level, threads);
+        let mut refiltered = simulation(&two_level, threads);
+        single.run_steps(2000).expect("stable");
+        refiltered.run_steps(2000).expect("stable");
+        println!(
+            "{threads} thread(s): single list {} builds, {} candidates; two levels {} builds + {} refilters, {} candidates",
+            single.neighbor_builds(),
+            single.candidate_pairs(),
+            refiltered.neighbor_builds(),
+            refiltered.neighbor_refilters(),
+            refiltered.candidate_pairs()
+        );
+        assert_eq!(single.neighbor_refilters(), 0);
+        assert!(refiltered.neighbor_refilters() > 10, "the run must refilter");
+        assert!(refiltered.candidate_pairs() < single.candidate_pairs());
+        if let Some(diff) = first_difference(&single.snapshot(), &refiltered.snapshot()) {
+            panic!("{threads} thread(s): the two-level list changes the result: {diff}");
+        }
+    }
+}

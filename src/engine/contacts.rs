@@ -9,7 +9,7 @@
 
 use super::Vec3;
 use super::models::ContactHistory;
-use super::neighbor::{BUILD_CHUNK, NeighborList};
+use super::neighbor::{BUILD_CHUNK, NeighborList, on_pool_thread};
 use super::particles::ParticleId;
 
 /// Index of a wall in the scenario's wall list.
@@ -336,39 +336,44 @@ impl AlignedHistory {
             .collect();
         let pair_ends: Vec<usize> = chunk_ends.iter().map(|&e| new_list.start[e] as usize).collect();
         let wall_ends: Vec<usize> = chunk_ends.iter().map(|&e| new_list.wall_start[e] as usize).collect();
-        let orphans = pair
+        let merge = |(c, (mut pairs, mut walls)): (usize, (ColumnsMut, ColumnsMut))| {
+            let lo = c * BUILD_CHUNK;
+            let hi = chunk_ends[c];
+            let (pair_base, wall_base) = (new_list.start[lo] as usize, new_list.wall_start[lo] as usize);
+            let mut orphans = 0;
+            for i in lo..hi {
+                orphans += merge_slots(
+                    &self.pair,
+                    old_list.pairs_of(i),
+                    &old_list.partner,
+                    &mut pairs,
+                    new_list.pairs_of(i),
+                    &new_list.partner,
+                    pair_base,
+                );
+                orphans += merge_slots(
+                    &self.wall,
+                    old_list.walls_of(i),
+                    &old_list.wall_partner,
+                    &mut walls,
+                    new_list.walls_of(i),
+                    &new_list.wall_partner,
+                    wall_base,
+                );
+            }
+            orphans
+        };
+        // In parallel on the simulation's pool, else on the calling thread (see `neighbor::on_pool_thread`).
+        let chunks = pair
             .split(&pair_ends)
-            .into_par_iter()
+            .into_iter()
             .zip(wall.split(&wall_ends))
-            .enumerate()
-            .map(|(c, (mut pairs, mut walls))| {
-                let lo = c * BUILD_CHUNK;
-                let hi = chunk_ends[c];
-                let (pair_base, wall_base) = (new_list.start[lo] as usize, new_list.wall_start[lo] as usize);
-                let mut orphans = 0;
-                for i in lo..hi {
-                    orphans += merge_slots(
-                        &self.pair,
-                        old_list.pairs_of(i),
-                        &old_list.partner,
-                        &mut pairs,
-                        new_list.pairs_of(i),
-                        &new_list.partner,
-                        pair_base,
-                    );
-                    orphans += merge_slots(
-                        &self.wall,
-                        old_list.walls_of(i),
-                        &old_list.wall_partner,
-                        &mut walls,
-                        new_list.walls_of(i),
-                        &new_list.wall_partner,
-                        wall_base,
-                    );
-                }
-                orphans
-            })
-            .sum();
+            .enumerate();
+        let orphans: usize = if on_pool_thread() {
+            chunks.collect::<Vec<_>>().into_par_iter().map(merge).sum()
+        } else {
+            chunks.map(merge).sum()
+        };
         (AlignedHistory { pair, wall }, orphans)
     }
 

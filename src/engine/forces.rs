@@ -745,6 +745,17 @@ impl RangePlan {
     pub fn balanced(list: &NeighborList, touching: &[bool], ranges: usize, previous: Option<&RangePlan>) -> RangePlan {
         let n = list.start.len().saturating_sub(1);
         let ranges = ranges.clamp(1, n.max(1));
+        if ranges == 1 {
+            // The serial pass: nothing to balance or to cross.
+            return RangePlan {
+                bounds: vec![0, n],
+                cross_from: vec![n],
+                incoming: Vec::new(),
+                incoming_start: vec![0, 0],
+                estimate: vec![n as f64],
+                busy_ns: vec![AtomicU64::new(0)],
+            };
+        }
         let speed: Option<Vec<f64>> = previous.filter(|p| *p.bounds.last().unwrap_or(&0) == n).and_then(|p| {
             let per_unit: Vec<f64> = p
                 .busy_ns

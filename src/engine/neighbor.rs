@@ -16,6 +16,23 @@ use super::geometry::{Domain, Wall};
 /// Particles per parallel work item in the build.
 pub const BUILD_CHUNK: usize = 1024;
 
+/// Whether list work runs in parallel: yes on a rayon pool's thread (a simulation hands its rebuilds to its own
+/// pool when it has several threads), no on any other thread, where a parallel iterator would hand the work to
+/// rayon's global pool. A one-thread simulation so builds on its own thread, without a hand-over per build (a
+/// thread wake-up, tens of µs, as much as a whole refilter of a small bed). Results are the same either way.
+pub fn on_pool_thread() -> bool {
+    rayon::current_thread_index().is_some()
+}
+
+/// `f` over `0..n`, collected in order: in parallel (items of at least `min_len`) on a pool thread, else serially.
+pub fn map_indices<T: Send>(n: usize, min_len: usize, f: impl Fn(usize) -> T + Sync + Send) -> Vec<T> {
+    if on_pool_thread() {
+        (0..n).into_par_iter().with_min_len(min_len).map(f).collect()
+    } else {
+        (0..n).map(f).collect()
+    }
+}
+
 /// How far beyond contact particles interact with each other and with walls (a cohesion model's range): the list
 /// holds every pair whose surfaces are closer than this plus the skin.
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
@@ -54,18 +71,15 @@ impl CellGrid {
         for axis in 0..3 {
             dims[axis] = ((length[axis] / cell_size_m).floor() as usize).max(1);
         }
-        let cell: Vec<[u32; 3]> = position
-            .par_iter()
-            .with_min_len(BUILD_CHUNK)
-            .map(|x| {
-                let mut c = [0u32; 3];
-                for axis in 0..3 {
-                    let f = (x[axis] - domain.lo_m[axis]) / length[axis] * dims[axis] as f64;
-                    c[axis] = (f.floor().max(0.0) as usize).min(dims[axis] - 1) as u32;
-                }
-                c
-            })
-            .collect();
+        let cell: Vec<[u32; 3]> = map_indices(position.len(), BUILD_CHUNK, |i| {
+            let x = &position[i];
+            let mut c = [0u32; 3];
+            for axis in 0..3 {
+                let f = (x[axis] - domain.lo_m[axis]) / length[axis] * dims[axis] as f64;
+                c[axis] = (f.floor().max(0.0) as usize).min(dims[axis] - 1) as u32;
+            }
+            c
+        });
         let n_cells = dims[0] * dims[1] * dims[2];
         let mut grid = CellGrid {
             dims,
@@ -118,6 +132,40 @@ impl CellGrid {
     }
 }
 
+/// What a list holds: pairs whose surfaces are closer than the interaction reach plus the skin, and walls likewise.
+struct Criteria<'a> {
+    domain: &'a Domain,
+    position: &'a [Vec3],
+    radius: &'a [f64],
+    skin_m: f64,
+    range: Reach,
+    walls: &'a [Wall],
+    wall_angle: &'a [f64],
+    pseudo_2d: bool,
+}
+
+impl Criteria<'_> {
+    #[inline(always)]
+    fn pair(&self, i: usize, j: usize) -> bool {
+        let reach = self.radius[i] + self.radius[j] + self.range.pair_gap_m + self.skin_m;
+        self.domain
+            .separation(&self.position[i], &self.position[j])
+            .norm_squared()
+            < reach * reach
+    }
+
+    #[inline(always)]
+    fn wall(&self, i: usize, w: u16) -> bool {
+        let (wall, ri) = (&self.walls[w as usize], self.radius[i]);
+        let reach = if self.pseudo_2d && wall.is_plane_normal_to_z() {
+            ri
+        } else {
+            ri + self.range.wall_gap_m + self.skin_m
+        };
+        wall.proximity(&self.position[i], self.wall_angle[w as usize]).gap_m < reach
+    }
+}
+
 impl NeighborList {
     pub fn pair_count(&self) -> usize {
         self.partner.len()
@@ -161,10 +209,35 @@ impl NeighborList {
             .any(|(w, (a, a0))| w.max_lever_m() * (a - a0).abs() > 0.5 * self.skin_m)
     }
 
+    /// True when some particle has moved more than `allowance_m` from where it was at the build, or a moving
+    /// wall's surface has. [`NeighborList::refilter`] asks it of the list it filters.
+    pub fn displaced_beyond(
+        &self,
+        domain: &Domain,
+        position: &[Vec3],
+        walls: &[Wall],
+        wall_angle: &[f64],
+        allowance_m: f64,
+    ) -> bool {
+        if self.reference_position.len() != position.len() || self.builds == 0 {
+            return true;
+        }
+        let limit2 = allowance_m * allowance_m;
+        position
+            .iter()
+            .zip(&self.reference_position)
+            .any(|(x, x0)| domain.separation(x, x0).norm_squared() > limit2)
+            || walls
+                .iter()
+                .zip(wall_angle.iter().zip(&self.reference_wall_angle))
+                .any(|(w, (a, a0))| w.max_lever_m() * (a - a0).abs() > allowance_m)
+    }
+
     /// Rebuilds the lists for particles of radius `radius` at `position`. Pairs are candidates when their surfaces
-    /// are closer than `range.pair_gap_m + skin_m`; particle–wall pairs likewise (with `range.wall_gap_m`), except that in a `pseudo_2d` run a plane normal to z
-    /// is a candidate only if the particle already overlaps it (its gap cannot change: in a one-layer bed every
-    /// particle just touches the front and back planes, which never push).
+    /// are closer than `range.pair_gap_m + skin_m`; particle–wall pairs likewise (with `range.wall_gap_m`), except
+    /// that in a `pseudo_2d` run a plane normal to z is a candidate only if the particle already overlaps it (its
+    /// gap cannot change: in a one-layer bed every particle just touches the front and back planes, which never
+    /// push).
     #[allow(clippy::too_many_arguments)]
     pub fn build(
         &mut self,
@@ -177,69 +250,117 @@ impl NeighborList {
         wall_angle: &[f64],
         pseudo_2d: bool,
     ) {
-        let n = position.len();
         let max_radius = radius.iter().copied().fold(0.0, f64::max);
         let grid = CellGrid::new(domain, position, 2.0 * max_radius + range.pair_gap_m + skin_m);
+        let criteria = Criteria {
+            domain,
+            position,
+            radius,
+            skin_m,
+            range,
+            walls,
+            wall_angle,
+            pseudo_2d,
+        };
+        self.assemble(&criteria, |i, partners, near_walls| {
+            let ci = grid.cell[i];
+            let (xs, nx) = grid.adjacent(ci[0], 0, domain.periodic[0]);
+            let (ys, ny) = grid.adjacent(ci[1], 1, domain.periodic[1]);
+            let (zs, nz) = grid.adjacent(ci[2], 2, domain.periodic[2]);
+            let before = partners.len();
+            for &cz in &zs[..nz] {
+                for &cy in &ys[..ny] {
+                    for &cx in &xs[..nx] {
+                        let c = grid.flat([cx, cy, cz]);
+                        for &j in &grid.particle[grid.start[c] as usize..grid.start[c + 1] as usize] {
+                            if j as usize > i && criteria.pair(i, j as usize) {
+                                partners.push(j);
+                            }
+                        }
+                    }
+                }
+            }
+            partners[before..].sort_unstable();
+            near_walls.extend((0..walls.len() as u16).filter(|&w| criteria.wall(i, w)));
+        });
+    }
 
+    /// Rebuilds the lists as [`NeighborList::build`] would with skin `skin_m`, taking the candidates from `outer`
+    /// (a list with a larger skin) instead of the cells: the two-level scheme of the force pass. Complete only while
+    /// no particle has moved more than (outer skin − `skin_m`)/2 since `outer` was built
+    /// ([`NeighborList::displaced_beyond`]); the caller checks that first.
+    #[allow(clippy::too_many_arguments)]
+    pub fn refilter(
+        &mut self,
+        outer: &NeighborList,
+        domain: &Domain,
+        position: &[Vec3],
+        radius: &[f64],
+        skin_m: f64,
+        range: Reach,
+        walls: &[Wall],
+        wall_angle: &[f64],
+        pseudo_2d: bool,
+    ) {
+        debug_assert!(skin_m <= outer.skin_m);
+        let criteria = Criteria {
+            domain,
+            position,
+            radius,
+            skin_m,
+            range,
+            walls,
+            wall_angle,
+            pseudo_2d,
+        };
+        self.assemble(&criteria, |i, partners, near_walls| {
+            partners.extend(
+                outer.partner[outer.pairs_of(i)]
+                    .iter()
+                    .filter(|&&j| criteria.pair(i, j as usize)),
+            );
+            near_walls.extend(
+                outer.wall_partner[outer.walls_of(i)]
+                    .iter()
+                    .filter(|&&w| criteria.wall(i, w)),
+            );
+        });
+    }
+
+    /// Becomes a copy of `other` (lists, reference state and skin), counting as a build.
+    pub fn adopt(&mut self, other: &NeighborList) {
+        let builds = self.builds;
+        self.clone_from(other);
+        self.builds = builds + 1;
+    }
+
+    /// Fills the lists from `candidates(i, partners, walls)`, which appends particle i's partners (ascending, all
+    /// greater than i) and walls (ascending), in parallel over chunks of particles; records the reference state.
+    fn assemble(&mut self, criteria: &Criteria, candidates: impl Fn(usize, &mut Vec<u32>, &mut Vec<u16>) + Sync) {
+        let n = criteria.position.len();
         struct Chunk {
             partners: Vec<u32>,
             counts: Vec<u32>,
             walls: Vec<u16>,
             wall_counts: Vec<u32>,
         }
-        let chunks: Vec<Chunk> = (0..n.div_ceil(BUILD_CHUNK))
-            .into_par_iter()
-            .map(|chunk| {
-                let lo = chunk * BUILD_CHUNK;
-                let hi = (lo + BUILD_CHUNK).min(n);
-                let mut out = Chunk {
-                    partners: Vec::with_capacity((hi - lo) * 8),
-                    counts: Vec::with_capacity(hi - lo),
-                    walls: Vec::new(),
-                    wall_counts: Vec::with_capacity(hi - lo),
-                };
-                for i in lo..hi {
-                    let before = out.partners.len();
-                    let ci = grid.cell[i];
-                    let (xs, nx) = grid.adjacent(ci[0], 0, domain.periodic[0]);
-                    let (ys, ny) = grid.adjacent(ci[1], 1, domain.periodic[1]);
-                    let (zs, nz) = grid.adjacent(ci[2], 2, domain.periodic[2]);
-                    let (xi, ri) = (position[i], radius[i]);
-                    for &cz in &zs[..nz] {
-                        for &cy in &ys[..ny] {
-                            for &cx in &xs[..nx] {
-                                let c = grid.flat([cx, cy, cz]);
-                                for &j in &grid.particle[grid.start[c] as usize..grid.start[c + 1] as usize] {
-                                    let j = j as usize;
-                                    if j <= i {
-                                        continue;
-                                    }
-                                    let reach = ri + radius[j] + range.pair_gap_m + skin_m;
-                                    if domain.separation(&xi, &position[j]).norm_squared() < reach * reach {
-                                        out.partners.push(j as u32);
-                                    }
-                                }
-                            }
-                        }
-                    }
-                    out.partners[before..].sort_unstable();
-                    out.counts.push((out.partners.len() - before) as u32);
-                    let walls_before = out.walls.len();
-                    for (w, wall) in walls.iter().enumerate() {
-                        let reach = if pseudo_2d && wall.is_plane_normal_to_z() {
-                            ri
-                        } else {
-                            ri + range.wall_gap_m + skin_m
-                        };
-                        if wall.proximity(&xi, wall_angle[w]).gap_m < reach {
-                            out.walls.push(w as u16);
-                        }
-                    }
-                    out.wall_counts.push((out.walls.len() - walls_before) as u32);
-                }
-                out
-            })
-            .collect();
+        let chunks: Vec<Chunk> = map_indices(n.div_ceil(BUILD_CHUNK), 1, |chunk| {
+            let lo = chunk * BUILD_CHUNK;
+            let hi = (lo + BUILD_CHUNK).min(n);
+            let mut out = Chunk {
+                partners: Vec::with_capacity((hi - lo) * 8),
+                counts: Vec::with_capacity(hi - lo),
+                walls: Vec::new(),
+                wall_counts: Vec::with_capacity(hi - lo),
+            };
+            for i in lo..hi {
+                let (before, walls_before) = (out.partners.len(), out.walls.len());
+                candidates(i, &mut out.partners, &mut out.walls);
+                out.counts.push((out.partners.len() - before) as u32);
+                out.wall_counts.push((out.walls.len() - walls_before) as u32);
+            }
+            out
+        });
 
         self.start.clear();
         self.start.reserve(n + 1);
@@ -264,10 +385,10 @@ impl NeighborList {
         }
 
         self.reference_position.clear();
-        self.reference_position.extend_from_slice(position);
+        self.reference_position.extend_from_slice(criteria.position);
         self.reference_wall_angle.clear();
-        self.reference_wall_angle.extend_from_slice(wall_angle);
-        self.skin_m = skin_m;
+        self.reference_wall_angle.extend_from_slice(criteria.wall_angle);
+        self.skin_m = criteria.skin_m;
         self.builds += 1;
     }
 
@@ -283,6 +404,75 @@ impl NeighborList {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The two-level scheme: a list refiltered with a smaller skin from a list built earlier (particles moved by
+    /// less than half the difference of the skins since) equals the list built directly with the smaller skin, for
+    /// pairs across a periodic axis and for walls.
+    #[test]
+    fn refiltered_list_equals_a_direct_build_with_the_inner_skin() {
+        use crate::engine::geometry::{Wall, WallShape};
+        use crate::engine::particles::SpeciesId;
+        let domain = Domain::new(Vec3::zeros(), Vec3::new(0.3, 0.3, 0.3), [true, false, false]);
+        let plane = |point: Vec3, normal: Vec3| Wall {
+            name: "plane".into(),
+            species: SpeciesId(0),
+            shape: WallShape::Plane { point_m: point, normal },
+        };
+        let walls = [
+            plane(Vec3::zeros(), Vec3::y()),
+            plane(Vec3::new(0.0, 0.3, 0.0), -Vec3::y()),
+            plane(Vec3::zeros(), Vec3::z()),
+        ];
+        let angles = [0.0; 3];
+        let mut state = 99u64;
+        let mut rnd = || {
+            state = state
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (state >> 11) as f64 / (1u64 << 53) as f64
+        };
+        let n = 600;
+        let start: Vec<Vec3> = (0..n)
+            .map(|_| Vec3::new(0.3 * rnd(), 0.3 * rnd(), 0.3 * rnd()))
+            .collect();
+        let radius: Vec<f64> = (0..n).map(|_| 0.01 + 0.01 * rnd()).collect();
+        let (skin, inner) = (0.02, 0.005);
+        let reach = Reach {
+            pair_gap_m: 0.002,
+            wall_gap_m: 0.001,
+        };
+        let mut outer = NeighborList::default();
+        outer.build(&domain, &start, &radius, skin, reach, &walls, &angles, false);
+        // Everyone moves by just under (skin − inner)/2, in random directions.
+        let allowance = 0.5 * (skin - inner);
+        let moved: Vec<Vec3> = start
+            .iter()
+            .map(|x| {
+                let d = Vec3::new(rnd() - 0.5, rnd() - 0.5, rnd() - 0.5).normalize() * (0.999 * allowance);
+                let mut y = x + d;
+                domain.wrap(&mut y);
+                y
+            })
+            .collect();
+        assert!(!outer.displaced_beyond(&domain, &moved, &walls, &angles, allowance));
+        let mut refiltered = NeighborList::default();
+        refiltered.refilter(&outer, &domain, &moved, &radius, inner, reach, &walls, &angles, false);
+        let mut direct = NeighborList::default();
+        direct.build(&domain, &moved, &radius, inner, reach, &walls, &angles, false);
+        assert_eq!(refiltered.start, direct.start);
+        assert_eq!(refiltered.partner, direct.partner);
+        assert_eq!(refiltered.wall_start, direct.wall_start);
+        assert_eq!(refiltered.wall_partner, direct.wall_partner);
+        assert!(
+            direct.pair_count() > 100 && direct.wall_partner.len() > 20,
+            "the test must have pairs and walls"
+        );
+        assert!(direct.pair_count() < outer.pair_count());
+        // Moving one particle a little further is what `displaced_beyond` reports.
+        let mut far = moved.clone();
+        far[7] = start[7] + Vec3::new(0.0, 1.01 * allowance, 0.0);
+        assert!(outer.displaced_beyond(&domain, &far, &walls, &angles, allowance));
+    }
 
     /// The cell-list half list equals the brute-force one, on periodic boxes with many cells per axis and with only
     /// one or two (where the adjacent cells on both sides are the same cell).

@@ -45,6 +45,13 @@ pub struct SimConfig {
     pub walls: Vec<Wall>,
     /// Neighbour-list skin: candidates are pairs whose surfaces are closer than this.
     pub skin_m: f64,
+    /// Skin of the force pass's own list when smaller than `skin_m` (the two-level scheme): that list is refiltered
+    /// from the candidates within `skin_m` whenever a particle has moved half of it, and the cells are searched
+    /// again only when the candidates themselves may be incomplete. Equal to `skin_m`: one level.
+    pub inner_skin_m: f64,
+    /// The inner skin was not chosen by the scenario: use two levels only after cell searches where it halves the
+    /// force pass's candidates (otherwise one level until the next search).
+    pub inner_skin_auto: bool,
     /// Largest tolerated overlap as a fraction of the smaller radius; beyond it the step fails.
     pub max_overlap_fraction: f64,
     /// Forces at a distance (liquid bridges, van der Waals, square well); `None`: dry, cohesionless particles.
@@ -83,7 +90,13 @@ pub struct Simulation {
     pub dt_s: f64,
     pub wall_angle_rad: Vec<f64>,
     pub rng: RngState,
+    /// The force pass's list: every pair within the inner skin (`SimConfig::inner_skin_m`).
     list: NeighborList,
+    /// The two-level scheme's outer list (pairs within `SimConfig::skin_m`), which `list` is refiltered from;
+    /// empty with one level.
+    candidates: NeighborList,
+    /// Refilters of `list` from `candidates` in this process.
+    refilters: u64,
     history: AlignedHistory,
     /// Cohesion states (bridges, wells), aligned with `list` like `history`.
     cohesion: AlignedCohesion,
@@ -136,6 +149,8 @@ impl Simulation {
             wall_angle_rad: vec![0.0; n_walls],
             rng,
             list: NeighborList::default(),
+            candidates: NeighborList::default(),
+            refilters: 0,
             history: AlignedHistory::default(),
             cohesion: AlignedCohesion::default(),
             cohesion_events: CohesionPass::default(),
@@ -172,6 +187,8 @@ impl Simulation {
             wall_angle_rad: state.wall_angle_rad,
             rng: state.rng,
             list: NeighborList::default(),
+            candidates: NeighborList::default(),
+            refilters: 0,
             history: AlignedHistory::default(),
             cohesion: AlignedCohesion::default(),
             cohesion_events: CohesionPass::default(),
@@ -188,18 +205,7 @@ impl Simulation {
             team: Team::new(threads),
             timers: StageTimers::default(),
         };
-        sim.with_pool(|sim| {
-            sim.list.build(
-                &sim.config.domain,
-                &sim.particles.position_m,
-                &sim.particles.radius_m,
-                sim.config.skin_m,
-                sim.config.reach(),
-                &sim.config.walls,
-                &sim.wall_angle_rad,
-                sim.config.pseudo_2d,
-            )
-        });
+        sim.on_list_threads(|sim| sim.build_lists());
         let layout = sim.config.contact_law.history_layout();
         let (history, orphans) = AlignedHistory::from_store(&state.contacts, &sim.list, layout);
         if orphans > 0 {
@@ -259,13 +265,27 @@ impl Simulation {
         ]
     }
 
+    /// Cell searches for neighbours in this process.
     pub fn neighbor_builds(&self) -> u64 {
-        self.list.builds
+        if self.two_level() {
+            self.candidates.builds
+        } else {
+            self.list.builds
+        }
     }
 
-    /// Number of candidate pairs in the neighbour list (each pair once).
+    /// Refilterings of the force pass's list from the outer candidates in this process (two-level scheme only).
+    pub fn neighbor_refilters(&self) -> u64 {
+        self.refilters
+    }
+
+    /// Number of candidate pairs the force pass examines (each pair once).
     pub fn candidate_pairs(&self) -> usize {
         self.list.pair_count()
+    }
+
+    fn two_level(&self) -> bool {
+        self.config.inner_skin_m < self.config.skin_m
     }
 
     /// Number of active particle–particle and particle–wall contacts.
@@ -278,7 +298,11 @@ impl Simulation {
 
     /// Approximate heap bytes of state and workspace.
     pub fn heap_bytes(&self) -> usize {
-        self.particles.heap_bytes() + self.list.heap_bytes() + self.history.heap_bytes() + self.buffers.heap_bytes()
+        self.particles.heap_bytes()
+            + self.list.heap_bytes()
+            + self.candidates.heap_bytes()
+            + self.history.heap_bytes()
+            + self.buffers.heap_bytes()
     }
 
     /// Advances `n` steps.
@@ -567,23 +591,12 @@ impl Simulation {
     }
 
     fn refresh_neighbors(&mut self) {
-        // The rebuild runs on the rayon pool: park the force-pass helpers so they do not spin on its cores.
-        self.team.rest();
         let old_list = std::mem::take(&mut self.list);
         self.list.builds = old_list.builds;
-        let (history, orphans) = self.with_pool(|s| {
-            let c = &s.config;
-            s.list.build(
-                &c.domain,
-                &s.particles.position_m,
-                &s.particles.radius_m,
-                c.skin_m,
-                c.reach(),
-                &c.walls,
-                &s.wall_angle_rad,
-                c.pseudo_2d,
-            );
-            s.history.remap(&old_list, &s.list, c.contact_law.history_layout())
+        let (history, orphans) = self.on_list_threads(|s| {
+            s.build_lists();
+            s.history
+                .remap(&old_list, &s.list, s.config.contact_law.history_layout())
         });
         // A contact is always a candidate of a list built from the same positions.
         debug_assert_eq!(orphans, 0, "contacts lost in a neighbour-list rebuild");
@@ -596,6 +609,73 @@ impl Simulation {
             self.cohesion = cohesion;
         }
         self.rebalance();
+    }
+
+    /// Brings `list` up to date with the current positions. Two-level: the outer candidates are searched for in
+    /// the cells again only if a particle (or wall) has moved more than (skin − inner skin)/2 since their build,
+    /// which would let a pair closer than the inner skin escape them; otherwise `list` is refiltered from them.
+    fn build_lists(&mut self) {
+        let c = &self.config;
+        let (position, radius) = (&self.particles.position_m, &self.particles.radius_m);
+        if !self.two_level() {
+            let (skin, reach) = (c.skin_m, c.reach());
+            self.list.build(
+                &c.domain,
+                position,
+                radius,
+                skin,
+                reach,
+                &c.walls,
+                &self.wall_angle_rad,
+                c.pseudo_2d,
+            );
+            return;
+        }
+        let allowance_m = 0.5 * (c.skin_m - c.inner_skin_m);
+        let searched =
+            self.candidates
+                .displaced_beyond(&c.domain, position, &c.walls, &self.wall_angle_rad, allowance_m);
+        if searched {
+            self.candidates.build(
+                &c.domain,
+                position,
+                radius,
+                c.skin_m,
+                c.reach(),
+                &c.walls,
+                &self.wall_angle_rad,
+                c.pseudo_2d,
+            );
+        } else {
+            self.refilters += 1;
+        }
+        self.list.refilter(
+            &self.candidates,
+            &c.domain,
+            position,
+            radius,
+            c.inner_skin_m,
+            c.reach(),
+            &c.walls,
+            &self.wall_angle_rad,
+            c.pseudo_2d,
+        );
+        if searched && c.inner_skin_auto && 2 * self.list.pair_count() > self.candidates.pair_count() {
+            // The inner skin does not halve the pairs the force pass examines (a loose or fast bed): refilters
+            // would cost more than they save, so one level until the next cell search.
+            self.list.adopt(&self.candidates);
+        }
+    }
+
+    /// Runs neighbour-list work: on the rayon pool with several threads (parking the force pass's helpers first so
+    /// that they do not spin on its cores), on this thread with one (see `neighbor::on_pool_thread`).
+    fn on_list_threads<R: Send>(&mut self, f: impl FnOnce(&mut Self) -> R + Send) -> R {
+        if self.threads() > 1 {
+            self.team.rest();
+            self.with_pool(f)
+        } else {
+            f(self)
+        }
     }
 
     fn with_pool<R: Send>(&mut self, f: impl FnOnce(&mut Self) -> R + Send) -> R {

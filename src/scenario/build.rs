@@ -153,6 +153,13 @@ pub fn build(spec: ScenarioSpec, path: &Path) -> Result<BuiltScenario, ConfigErr
 
     let skin_m = spec.neighbor.skin_m.unwrap_or(0.4 * particles.max_radius_m());
     c.positive("neighbor.skin_m", skin_m)?;
+    let inner_skin_m = spec.neighbor.inner_skin_m.unwrap_or(0.25 * skin_m);
+    if !(inner_skin_m.is_finite() && inner_skin_m > 0.0 && inner_skin_m <= skin_m) {
+        return Err(c.fail(
+            "neighbor.inner_skin_m",
+            format!("expected 0 < value <= neighbor.skin_m ({skin_m} m), got {inner_skin_m}"),
+        ));
+    }
     c.positive("time.end_time_s", spec.time.end_time_s)?;
     c.positive("time.reference_velocity_m_per_s", spec.time.reference_velocity_m_per_s)?;
     if !(spec.max_overlap_fraction.is_finite() && spec.max_overlap_fraction > 0.0 && spec.max_overlap_fraction <= 1.0) {
@@ -276,6 +283,8 @@ pub fn build(spec: ScenarioSpec, path: &Path) -> Result<BuiltScenario, ConfigErr
         contact_law: spec.contact,
         walls,
         skin_m,
+        inner_skin_m,
+        inner_skin_auto: spec.neighbor.inner_skin_m.is_none(),
         max_overlap_fraction: spec.max_overlap_fraction,
         cohesion,
     };

@@ -204,6 +204,12 @@ pub struct NeighborSpec {
     /// as in its LIGGGHTS input).
     #[serde(default)]
     pub skin_m: Option<f64>,
+    /// Skin of the force pass's own list, refiltered from the candidates within `skin_m` each time a particle has
+    /// moved half of it (the cells are searched only when a particle has moved (skin_m − inner_skin_m)/2).
+    /// Results do not depend on it, only the speed. Default: skin_m / 4, used after a cell search only where it
+    /// halves the pairs the force pass examines (dense, slow beds); given: always; equal to skin_m: one list.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub inner_skin_m: Option<f64>,
 }
 
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize, schemars::JsonSchema)]
