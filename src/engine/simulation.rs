@@ -205,7 +205,7 @@ impl Simulation {
             team: Team::new(threads),
             timers: StageTimers::default(),
         };
-        sim.on_list_threads(|sim| sim.build_lists());
+        sim.on_list_threads(true, |sim| sim.build_lists(true));
         let layout = sim.config.contact_law.history_layout();
         let (history, orphans) = AlignedHistory::from_store(&state.contacts, &sim.list, layout);
         if orphans > 0 {
@@ -593,8 +593,11 @@ impl Simulation {
     fn refresh_neighbors(&mut self) {
         let old_list = std::mem::take(&mut self.list);
         self.list.builds = old_list.builds;
-        let (history, orphans) = self.on_list_threads(|s| {
-            s.build_lists();
+        // A cell search runs on the pool with several threads; a refilter is too short to be worth the hand-over
+        // (and the force pass's helpers keep spinning through it).
+        let search = self.needs_cell_search();
+        let (history, orphans) = self.on_list_threads(search, |s| {
+            s.build_lists(search);
             s.history
                 .remap(&old_list, &s.list, s.config.contact_law.history_layout())
         });
@@ -611,10 +614,25 @@ impl Simulation {
         self.rebalance();
     }
 
-    /// Brings `list` up to date with the current positions. Two-level: the outer candidates are searched for in
-    /// the cells again only if a particle (or wall) has moved more than (skin − inner skin)/2 since their build,
-    /// which would let a pair closer than the inner skin escape them; otherwise `list` is refiltered from them.
-    fn build_lists(&mut self) {
+    /// Whether bringing `list` up to date needs a search of the cells. Two-level: only if a particle (or wall) has
+    /// moved more than (skin − inner skin)/2 since the outer candidates were found, which would let a pair closer
+    /// than the inner skin escape them; otherwise `list` is refiltered from them.
+    fn needs_cell_search(&self) -> bool {
+        let c = &self.config;
+        let allowance_m = 0.5 * (c.skin_m - c.inner_skin_m);
+        !self.two_level()
+            || self.candidates.displaced_beyond(
+                &c.domain,
+                &self.particles.position_m,
+                &c.walls,
+                &self.wall_angle_rad,
+                allowance_m,
+            )
+    }
+
+    /// Brings `list` up to date with the current positions, with a cell search when `searched` (which must be
+    /// true whenever [`Simulation::needs_cell_search`] is).
+    fn build_lists(&mut self, searched: bool) {
         let c = &self.config;
         let (position, radius) = (&self.particles.position_m, &self.particles.radius_m);
         if !self.two_level() {
@@ -631,10 +649,6 @@ impl Simulation {
             );
             return;
         }
-        let allowance_m = 0.5 * (c.skin_m - c.inner_skin_m);
-        let searched =
-            self.candidates
-                .displaced_beyond(&c.domain, position, &c.walls, &self.wall_angle_rad, allowance_m);
         if searched {
             self.candidates.build(
                 &c.domain,
@@ -667,10 +681,11 @@ impl Simulation {
         }
     }
 
-    /// Runs neighbour-list work: on the rayon pool with several threads (parking the force pass's helpers first so
-    /// that they do not spin on its cores), on this thread with one (see `neighbor::on_pool_thread`).
-    fn on_list_threads<R: Send>(&mut self, f: impl FnOnce(&mut Self) -> R + Send) -> R {
-        if self.threads() > 1 {
+    /// Runs neighbour-list work: on the rayon pool when `parallel` and there are several threads (parking the force
+    /// pass's helpers first so that they do not spin on its cores), else on this thread (see
+    /// `neighbor::on_pool_thread`).
+    fn on_list_threads<R: Send>(&mut self, parallel: bool, f: impl FnOnce(&mut Self) -> R + Send) -> R {
+        if parallel && self.threads() > 1 {
             self.team.rest();
             self.with_pool(f)
         } else {
