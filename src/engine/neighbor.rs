@@ -132,16 +132,20 @@ impl CellGrid {
     }
 }
 
-/// What a list holds: pairs whose surfaces are closer than the interaction reach plus the skin, and walls likewise.
-struct Criteria<'a> {
-    domain: &'a Domain,
-    position: &'a [Vec3],
-    radius: &'a [f64],
-    skin_m: f64,
-    range: Reach,
-    walls: &'a [Wall],
-    wall_angle: &'a [f64],
-    pseudo_2d: bool,
+/// What a list holds, for particles of radius `radius` at `position`: pairs whose surfaces are closer than
+/// `range.pair_gap_m + skin_m`, and particle–wall pairs likewise (with `range.wall_gap_m`), except that in a
+/// `pseudo_2d` run a plane normal to z is a candidate only if the particle already overlaps it (its gap cannot
+/// change: in a one-layer bed every particle just touches the front and back planes, which never push).
+#[derive(Clone, Copy)]
+pub struct Criteria<'a> {
+    pub domain: &'a Domain,
+    pub position: &'a [Vec3],
+    pub radius: &'a [f64],
+    pub skin_m: f64,
+    pub range: Reach,
+    pub walls: &'a [Wall],
+    pub wall_angle: &'a [f64],
+    pub pseudo_2d: bool,
 }
 
 impl Criteria<'_> {
@@ -233,36 +237,20 @@ impl NeighborList {
                 .any(|(w, (a, a0))| w.max_lever_m() * (a - a0).abs() > allowance_m)
     }
 
-    /// Rebuilds the lists for particles of radius `radius` at `position`. Pairs are candidates when their surfaces
-    /// are closer than `range.pair_gap_m + skin_m`; particle–wall pairs likewise (with `range.wall_gap_m`), except
-    /// that in a `pseudo_2d` run a plane normal to z is a candidate only if the particle already overlaps it (its
-    /// gap cannot change: in a one-layer bed every particle just touches the front and back planes, which never
-    /// push).
-    #[allow(clippy::too_many_arguments)]
-    pub fn build(
-        &mut self,
-        domain: &Domain,
-        position: &[Vec3],
-        radius: &[f64],
-        skin_m: f64,
-        range: Reach,
-        walls: &[Wall],
-        wall_angle: &[f64],
-        pseudo_2d: bool,
-    ) {
-        let max_radius = radius.iter().copied().fold(0.0, f64::max);
-        let grid = CellGrid::new(domain, position, 2.0 * max_radius + range.pair_gap_m + skin_m);
-        let criteria = Criteria {
+    /// Rebuilds the lists by searching the cells for what `criteria` holds.
+    pub fn build(&mut self, criteria: &Criteria) {
+        let Criteria {
             domain,
             position,
             radius,
             skin_m,
             range,
             walls,
-            wall_angle,
-            pseudo_2d,
-        };
-        self.assemble(&criteria, |i, partners, near_walls| {
+            ..
+        } = *criteria;
+        let max_radius = radius.iter().copied().fold(0.0, f64::max);
+        let grid = CellGrid::new(domain, position, 2.0 * max_radius + range.pair_gap_m + skin_m);
+        self.assemble(criteria, |i, partners, near_walls| {
             let ci = grid.cell[i];
             let (xs, nx) = grid.adjacent(ci[0], 0, domain.periodic[0]);
             let (ys, ny) = grid.adjacent(ci[1], 1, domain.periodic[1]);
@@ -285,35 +273,13 @@ impl NeighborList {
         });
     }
 
-    /// Rebuilds the lists as [`NeighborList::build`] would with skin `skin_m`, taking the candidates from `outer`
-    /// (a list with a larger skin) instead of the cells: the two-level scheme of the force pass. Complete only while
-    /// no particle has moved more than (outer skin − `skin_m`)/2 since `outer` was built
+    /// Rebuilds the lists as [`NeighborList::build`] would for `criteria`, taking the candidates from `outer` (a
+    /// list with a larger skin) instead of the cells: the two-level scheme of the force pass. Complete only while no
+    /// particle has moved more than (outer skin − `criteria.skin_m`)/2 since `outer` was built
     /// ([`NeighborList::displaced_beyond`]); the caller checks that first.
-    #[allow(clippy::too_many_arguments)]
-    pub fn refilter(
-        &mut self,
-        outer: &NeighborList,
-        domain: &Domain,
-        position: &[Vec3],
-        radius: &[f64],
-        skin_m: f64,
-        range: Reach,
-        walls: &[Wall],
-        wall_angle: &[f64],
-        pseudo_2d: bool,
-    ) {
-        debug_assert!(skin_m <= outer.skin_m);
-        let criteria = Criteria {
-            domain,
-            position,
-            radius,
-            skin_m,
-            range,
-            walls,
-            wall_angle,
-            pseudo_2d,
-        };
-        self.assemble(&criteria, |i, partners, near_walls| {
+    pub fn refilter(&mut self, outer: &NeighborList, criteria: &Criteria) {
+        debug_assert!(criteria.skin_m <= outer.skin_m);
+        self.assemble(criteria, |i, partners, near_walls| {
             partners.extend(
                 outer.partner[outer.pairs_of(i)]
                     .iter()
@@ -441,8 +407,18 @@ mod tests {
             pair_gap_m: 0.002,
             wall_gap_m: 0.001,
         };
+        let at_start = Criteria {
+            domain: &domain,
+            position: &start,
+            radius: &radius,
+            skin_m: skin,
+            range: reach,
+            walls: &walls,
+            wall_angle: &angles,
+            pseudo_2d: false,
+        };
         let mut outer = NeighborList::default();
-        outer.build(&domain, &start, &radius, skin, reach, &walls, &angles, false);
+        outer.build(&at_start);
         // Everyone moves by just under (skin − inner)/2, in random directions.
         let allowance = 0.5 * (skin - inner);
         let moved: Vec<Vec3> = start
@@ -456,9 +432,14 @@ mod tests {
             .collect();
         assert!(!outer.displaced_beyond(&domain, &moved, &walls, &angles, allowance));
         let mut refiltered = NeighborList::default();
-        refiltered.refilter(&outer, &domain, &moved, &radius, inner, reach, &walls, &angles, false);
+        let moved_inner = Criteria {
+            position: &moved,
+            skin_m: inner,
+            ..at_start
+        };
+        refiltered.refilter(&outer, &moved_inner);
         let mut direct = NeighborList::default();
-        direct.build(&domain, &moved, &radius, inner, reach, &walls, &angles, false);
+        direct.build(&moved_inner);
         assert_eq!(refiltered.start, direct.start);
         assert_eq!(refiltered.partner, direct.partner);
         assert_eq!(refiltered.wall_start, direct.wall_start);
@@ -496,7 +477,16 @@ mod tests {
                 .collect();
             let radius: Vec<f64> = (0..n).map(|_| 0.02 + 0.02 * rnd()).collect();
             let mut list = NeighborList::default();
-            list.build(&domain, &position, &radius, 0.01, Reach::default(), &[], &[], false);
+            list.build(&Criteria {
+                domain: &domain,
+                position: &position,
+                radius: &radius,
+                skin_m: 0.01,
+                range: Reach::default(),
+                walls: &[],
+                wall_angle: &[],
+                pseudo_2d: false,
+            });
             for i in 0..n {
                 let mut expected = vec![];
                 for j in i + 1..n {

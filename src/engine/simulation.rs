@@ -16,7 +16,7 @@ use super::geometry::{Domain, Gravity, Wall};
 use super::integrate::{InverseInertia, find_lost, kick_drift};
 use super::models::cohesion_law::{CohesionModel, LiquidBridge};
 use super::models::{ContactLaw, PairTable};
-use super::neighbor::{NeighborList, Reach};
+use super::neighbor::{Criteria, NeighborList, Reach};
 use super::net_force::NetForceTally;
 use super::particles::{ParticleId, Particles, SpeciesTable};
 use super::spray::spray_surface;
@@ -634,46 +634,30 @@ impl Simulation {
     /// true whenever [`Simulation::needs_cell_search`] is).
     fn build_lists(&mut self, searched: bool) {
         let c = &self.config;
-        let (position, radius) = (&self.particles.position_m, &self.particles.radius_m);
+        let outer = Criteria {
+            domain: &c.domain,
+            position: &self.particles.position_m,
+            radius: &self.particles.radius_m,
+            skin_m: c.skin_m,
+            range: c.reach(),
+            walls: &c.walls,
+            wall_angle: &self.wall_angle_rad,
+            pseudo_2d: c.pseudo_2d,
+        };
         if !self.two_level() {
-            let (skin, reach) = (c.skin_m, c.reach());
-            self.list.build(
-                &c.domain,
-                position,
-                radius,
-                skin,
-                reach,
-                &c.walls,
-                &self.wall_angle_rad,
-                c.pseudo_2d,
-            );
+            self.list.build(&outer);
             return;
         }
         if searched {
-            self.candidates.build(
-                &c.domain,
-                position,
-                radius,
-                c.skin_m,
-                c.reach(),
-                &c.walls,
-                &self.wall_angle_rad,
-                c.pseudo_2d,
-            );
+            self.candidates.build(&outer);
         } else {
             self.refilters += 1;
         }
-        self.list.refilter(
-            &self.candidates,
-            &c.domain,
-            position,
-            radius,
-            c.inner_skin_m,
-            c.reach(),
-            &c.walls,
-            &self.wall_angle_rad,
-            c.pseudo_2d,
-        );
+        let inner = Criteria {
+            skin_m: c.inner_skin_m,
+            ..outer
+        };
+        self.list.refilter(&self.candidates, &inner);
         if searched && c.inner_skin_auto && 2 * self.list.pair_count() > self.candidates.pair_count() {
             // The inner skin does not halve the pairs the force pass examines (a loose or fast bed): refilters
             // would cost more than they save, so one level until the next cell search.
