@@ -371,6 +371,17 @@ impl NeighborList {
 mod tests {
     use super::*;
 
+    /// Uniform numbers in [0, 1) from a 64-bit LCG seeded with `seed` (reproducible test positions and radii).
+    fn uniform(seed: u64) -> impl FnMut() -> f64 {
+        let mut state = seed;
+        move || {
+            state = state
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (state >> 11) as f64 / (1u64 << 53) as f64
+        }
+    }
+
     /// The two-level scheme: a list refiltered with a smaller skin from a list built earlier (particles moved by
     /// less than half the difference of the skins since) equals the list built directly with the smaller skin, for
     /// pairs across a periodic axis and for walls.
@@ -390,13 +401,7 @@ mod tests {
             plane(Vec3::zeros(), Vec3::z()),
         ];
         let angles = [0.0; 3];
-        let mut state = 99u64;
-        let mut rnd = || {
-            state = state
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            (state >> 11) as f64 / (1u64 << 53) as f64
-        };
+        let mut rnd = uniform(99);
         let n = 600;
         let start: Vec<Vec3> = (0..n)
             .map(|_| Vec3::new(0.3 * rnd(), 0.3 * rnd(), 0.3 * rnd()))
@@ -464,13 +469,7 @@ mod tests {
             (Vec3::new(0.1, 0.2, 0.5), [true, true, false]),
         ] {
             let domain = Domain::new(Vec3::zeros(), hi, periodic);
-            let mut state = 12345u64;
-            let mut rnd = || {
-                state = state
-                    .wrapping_mul(6364136223846793005)
-                    .wrapping_add(1442695040888963407);
-                (state >> 11) as f64 / (1u64 << 53) as f64
-            };
+            let mut rnd = uniform(12345);
             let n = 400;
             let position: Vec<Vec3> = (0..n)
                 .map(|_| Vec3::new(hi.x * rnd(), hi.y * rnd(), hi.z * rnd()))
