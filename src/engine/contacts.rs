@@ -9,8 +9,9 @@
 
 use super::Vec3;
 use super::models::ContactHistory;
-use super::neighbor::{BUILD_CHUNK, NeighborList, on_pool_thread};
+use super::neighbor::{BUILD_CHUNK, NeighborList};
 use super::particles::ParticleId;
+use super::team::Team;
 
 /// Index of a wall in the scenario's wall list.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash)]
@@ -170,6 +171,18 @@ impl HistoryColumns {
 }
 
 impl ColumnsMut<'_> {
+    /// A view of the same slots for a shorter borrow (to hand to a function by value and use again after).
+    pub fn reborrow(&mut self) -> ColumnsMut<'_> {
+        ColumnsMut {
+            layout: self.layout,
+            touching: self.touching,
+            tangential: self.tangential,
+            reversal: self.reversal,
+            direction: self.direction,
+            thornton: self.thornton,
+        }
+    }
+
     /// The history of local slot k with the layout known at compile time (`WB`: Walton-Braun columns, `TH`: Thornton
     /// columns), so that the fields a law does not use never touch memory. Must match the view's layout.
     #[inline(always)]
@@ -322,8 +335,8 @@ impl AlignedHistory {
         old_list: &NeighborList,
         new_list: &NeighborList,
         layout: HistoryLayout,
+        team: Option<&Team>,
     ) -> (AlignedHistory, usize) {
-        use rayon::prelude::*;
         if old_list.start.len() != new_list.start.len() {
             // A different particle set (or no list yet): go through the keyed store.
             return AlignedHistory::from_store(&self.to_store(old_list), new_list, layout);
@@ -363,16 +376,15 @@ impl AlignedHistory {
             }
             orphans
         };
-        // In parallel on the simulation's pool, else on the calling thread (see `neighbor::on_pool_thread`).
+        // On the simulation's team if given, else on the calling thread.
         let chunks = pair
             .split(&pair_ends)
             .into_iter()
             .zip(wall.split(&wall_ends))
             .enumerate();
-        let orphans: usize = if on_pool_thread() {
-            chunks.collect::<Vec<_>>().into_par_iter().map(merge).sum()
-        } else {
-            chunks.map(merge).sum()
+        let orphans: usize = match team {
+            Some(team) if team.size() > 1 => team.map_parts(chunks.collect(), |_, c| merge(c)).into_iter().sum(),
+            _ => chunks.map(merge).sum(),
         };
         (AlignedHistory { pair, wall }, orphans)
     }

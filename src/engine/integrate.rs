@@ -6,11 +6,10 @@
 //! integrator is memory-bound, so passes, not arithmetic, set its cost. Each particle is updated independently, so the parallel loops are
 //! trivially deterministic.
 
-use rayon::prelude::*;
-
 use super::Vec3;
 use super::geometry::Domain;
 use super::particles::Particles;
+use super::team::Team;
 
 const CHUNK: usize = 2048;
 
@@ -49,8 +48,8 @@ pub fn half_kick_one(
 }
 
 /// First half of a step: half kick and drift (wrapped on periodic axes). Returns the largest squared displacement
-/// from `reference` (the positions at the last neighbour-list build; empty = skip). With `parallel`, chunks run on
-/// the current rayon pool; without, on the calling thread (the same chunks, so the same bits).
+/// from `reference` (the positions at the last neighbour-list build; empty = skip). With a `team` of several
+/// threads, chunks run on it; without, on the calling thread (per-particle arithmetic, so the same bits).
 ///
 /// No checks here: velocities were checked finite by the kick that made them (`forces.rs`), so positions stay
 /// finite, and lost particles are looked for when the neighbour list is rebuilt (a particle cannot leave the box
@@ -64,7 +63,7 @@ pub fn kick_drift(
     pseudo_2d: bool,
     domain: &Domain,
     reference: &[Vec3],
-    parallel: bool,
+    team: Option<&Team>,
 ) -> f64 {
     let half_dt = 0.5 * dt_s;
     let g_half_dt = gravity * half_dt;
@@ -98,7 +97,7 @@ pub fn kick_drift(
             }
             max_d2
         };
-    if !parallel {
+    let Some(team) = team.filter(|t| t.size() > 1) else {
         // One chunk covering every particle: the same per-particle arithmetic, and the maximum of the chunk maxima
         // is the maximum.
         return chunk(
@@ -110,21 +109,23 @@ pub fn kick_drift(
             &p.torque_n_m,
             (&inverse.inv_mass_per_kg, &inverse.inv_inertia_per_kg_m2),
         );
-    }
-    p.position_m
-        .par_chunks_mut(CHUNK)
-        .zip(p.velocity_m_per_s.par_chunks_mut(CHUNK))
-        .zip(p.angular_velocity_rad_per_s.par_chunks_mut(CHUNK))
-        .zip(p.force_n.par_chunks(CHUNK).zip(p.torque_n_m.par_chunks(CHUNK)))
+    };
+    let parts: Vec<_> = p
+        .position_m
+        .chunks_mut(CHUNK)
+        .zip(p.velocity_m_per_s.chunks_mut(CHUNK))
+        .zip(p.angular_velocity_rad_per_s.chunks_mut(CHUNK))
+        .zip(p.force_n.chunks(CHUNK).zip(p.torque_n_m.chunks(CHUNK)))
         .zip(
             inverse
                 .inv_mass_per_kg
-                .par_chunks(CHUNK)
-                .zip(inverse.inv_inertia_per_kg_m2.par_chunks(CHUNK)),
+                .chunks(CHUNK)
+                .zip(inverse.inv_inertia_per_kg_m2.chunks(CHUNK)),
         )
-        .enumerate()
-        .map(|(c, ((((x, v), w), (f, t)), inv))| chunk(c, x, v, w, f, t, inv))
-        .reduce(|| 0.0, f64::max)
+        .collect();
+    team.map_parts(parts, |c, ((((x, v), w), (f, t)), inv)| chunk(c, x, v, w, f, t, inv))
+        .into_iter()
+        .fold(0.0, f64::max)
 }
 
 /// The first particle outside the box by more than `tolerance_m` on a non-periodic axis, or not finite.

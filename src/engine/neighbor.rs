@@ -8,28 +8,28 @@
 //! than half the skin) and is never checkpointed. What it finds does not depend on when it was built, so results do
 //! not either.
 
-use rayon::prelude::*;
-
 use super::Vec3;
 use super::geometry::{Domain, Wall};
+use super::team::Team;
 
-/// Particles per parallel work item in the build.
+/// Particles per work item in the build.
 pub const BUILD_CHUNK: usize = 1024;
 
-/// Whether list work runs in parallel: yes on a rayon pool's thread (a simulation hands its rebuilds to its own
-/// pool when it has several threads), no on any other thread, where a parallel iterator would hand the work to
-/// rayon's global pool. A one-thread simulation so builds on its own thread, without a hand-over per build (a
-/// thread wake-up, tens of µs, as much as a whole refilter of a small bed). Results are the same either way.
-pub fn on_pool_thread() -> bool {
-    rayon::current_thread_index().is_some()
-}
-
-/// `f` over `0..n`, collected in order: in parallel (items of at least `min_len`) on a pool thread, else serially.
-pub fn map_indices<T: Send>(n: usize, min_len: usize, f: impl Fn(usize) -> T + Sync + Send) -> Vec<T> {
-    if on_pool_thread() {
-        (0..n).into_par_iter().with_min_len(min_len).map(f).collect()
-    } else {
-        (0..n).map(f).collect()
+/// `f` over `0..n`, collected in order: on `team`'s threads in parts of `part_len` indices when there is a team of
+/// several threads, else on the calling thread. A simulation passes the force pass's team, whose helpers are still
+/// spinning from the last force pass, so the hand-over costs no thread wake-up. Results are the same either way.
+pub fn map_indices<T: Send>(team: Option<&Team>, n: usize, part_len: usize, f: impl Fn(usize) -> T + Sync) -> Vec<T> {
+    match team {
+        Some(team) if team.size() > 1 && n > part_len => {
+            let parts: Vec<std::ops::Range<usize>> = (0..n.div_ceil(part_len))
+                .map(|k| k * part_len..((k + 1) * part_len).min(n))
+                .collect();
+            let results = team.map_parts(parts, |_, part| part.map(&f).collect::<Vec<T>>());
+            let mut out = Vec::with_capacity(n);
+            results.into_iter().for_each(|mut part| out.append(&mut part));
+            out
+        }
+        _ => (0..n).map(f).collect(),
     }
 }
 
@@ -65,13 +65,13 @@ struct CellGrid {
 }
 
 impl CellGrid {
-    fn new(domain: &Domain, position: &[Vec3], cell_size_m: f64) -> Self {
+    fn new(domain: &Domain, position: &[Vec3], cell_size_m: f64, team: Option<&Team>) -> Self {
         let length = domain.length_m();
         let mut dims = [1usize; 3];
         for axis in 0..3 {
             dims[axis] = ((length[axis] / cell_size_m).floor() as usize).max(1);
         }
-        let cell: Vec<[u32; 3]> = map_indices(position.len(), BUILD_CHUNK, |i| {
+        let cell: Vec<[u32; 3]> = map_indices(team, position.len(), BUILD_CHUNK, |i| {
             let x = &position[i];
             let mut c = [0u32; 3];
             for axis in 0..3 {
@@ -237,8 +237,8 @@ impl NeighborList {
                 .any(|(w, (a, a0))| w.max_lever_m() * (a - a0).abs() > allowance_m)
     }
 
-    /// Rebuilds the lists by searching the cells for what `criteria` holds.
-    pub fn build(&mut self, criteria: &Criteria) {
+    /// Rebuilds the lists by searching the cells for what `criteria` holds, on `team` if given.
+    pub fn build(&mut self, criteria: &Criteria, team: Option<&Team>) {
         let Criteria {
             domain,
             position,
@@ -249,8 +249,8 @@ impl NeighborList {
             ..
         } = *criteria;
         let max_radius = radius.iter().copied().fold(0.0, f64::max);
-        let grid = CellGrid::new(domain, position, 2.0 * max_radius + range.pair_gap_m + skin_m);
-        self.assemble(criteria, |i, partners, near_walls| {
+        let grid = CellGrid::new(domain, position, 2.0 * max_radius + range.pair_gap_m + skin_m, team);
+        self.assemble(criteria, team, |i, partners, near_walls| {
             let ci = grid.cell[i];
             let (xs, nx) = grid.adjacent(ci[0], 0, domain.periodic[0]);
             let (ys, ny) = grid.adjacent(ci[1], 1, domain.periodic[1]);
@@ -277,9 +277,9 @@ impl NeighborList {
     /// list with a larger skin) instead of the cells: the two-level scheme of the force pass. Complete only while no
     /// particle has moved more than (outer skin − `criteria.skin_m`)/2 since `outer` was built
     /// ([`NeighborList::displaced_beyond`]); the caller checks that first.
-    pub fn refilter(&mut self, outer: &NeighborList, criteria: &Criteria) {
+    pub fn refilter(&mut self, outer: &NeighborList, criteria: &Criteria, team: Option<&Team>) {
         debug_assert!(criteria.skin_m <= outer.skin_m);
-        self.assemble(criteria, |i, partners, near_walls| {
+        self.assemble(criteria, team, |i, partners, near_walls| {
             partners.extend(
                 outer.partner[outer.pairs_of(i)]
                     .iter()
@@ -301,8 +301,14 @@ impl NeighborList {
     }
 
     /// Fills the lists from `candidates(i, partners, walls)`, which appends particle i's partners (ascending, all
-    /// greater than i) and walls (ascending), in parallel over chunks of particles; records the reference state.
-    fn assemble(&mut self, criteria: &Criteria, candidates: impl Fn(usize, &mut Vec<u32>, &mut Vec<u16>) + Sync) {
+    /// greater than i) and walls (ascending), over chunks of particles (on `team` if given); records the reference
+    /// state.
+    fn assemble(
+        &mut self,
+        criteria: &Criteria,
+        team: Option<&Team>,
+        candidates: impl Fn(usize, &mut Vec<u32>, &mut Vec<u16>) + Sync,
+    ) {
         let n = criteria.position.len();
         struct Chunk {
             partners: Vec<u32>,
@@ -310,7 +316,7 @@ impl NeighborList {
             walls: Vec<u16>,
             wall_counts: Vec<u32>,
         }
-        let chunks: Vec<Chunk> = map_indices(n.div_ceil(BUILD_CHUNK), 1, |chunk| {
+        let chunks: Vec<Chunk> = map_indices(team, n.div_ceil(BUILD_CHUNK), 1, |chunk| {
             let lo = chunk * BUILD_CHUNK;
             let hi = (lo + BUILD_CHUNK).min(n);
             let mut out = Chunk {
@@ -423,7 +429,7 @@ mod tests {
             pseudo_2d: false,
         };
         let mut outer = NeighborList::default();
-        outer.build(&at_start);
+        outer.build(&at_start, None);
         // Everyone moves by just under (skin − inner)/2, in random directions.
         let allowance = 0.5 * (skin - inner);
         let moved: Vec<Vec3> = start
@@ -442,9 +448,9 @@ mod tests {
             skin_m: inner,
             ..at_start
         };
-        refiltered.refilter(&outer, &moved_inner);
+        refiltered.refilter(&outer, &moved_inner, None);
         let mut direct = NeighborList::default();
-        direct.build(&moved_inner);
+        direct.build(&moved_inner, None);
         assert_eq!(refiltered.start, direct.start);
         assert_eq!(refiltered.partner, direct.partner);
         assert_eq!(refiltered.wall_start, direct.wall_start);
@@ -470,13 +476,13 @@ mod tests {
         ] {
             let domain = Domain::new(Vec3::zeros(), hi, periodic);
             let mut rnd = uniform(12345);
-            let n = 400;
+            // Several build chunks, so that the two-thread build splits the work.
+            let n = 2 * BUILD_CHUNK + 300;
             let position: Vec<Vec3> = (0..n)
                 .map(|_| Vec3::new(hi.x * rnd(), hi.y * rnd(), hi.z * rnd()))
                 .collect();
             let radius: Vec<f64> = (0..n).map(|_| 0.02 + 0.02 * rnd()).collect();
-            let mut list = NeighborList::default();
-            list.build(&Criteria {
+            let criteria = Criteria {
                 domain: &domain,
                 position: &position,
                 radius: &radius,
@@ -485,7 +491,12 @@ mod tests {
                 walls: &[],
                 wall_angle: &[],
                 pseudo_2d: false,
-            });
+            };
+            let mut list = NeighborList::default();
+            list.build(&criteria, None);
+            let mut on_team = NeighborList::default();
+            on_team.build(&criteria, Some(&Team::new(2)));
+            assert_eq!((&on_team.start, &on_team.partner), (&list.start, &list.partner));
             for i in 0..n {
                 let mut expected = vec![];
                 for j in i + 1..n {

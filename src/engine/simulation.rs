@@ -115,9 +115,9 @@ pub struct Simulation {
     accumulators_zeroed: bool,
     /// Force passes since the particle ranges were last rebalanced.
     steps_since_rebalance: u64,
-    pool: Arc<rayon::ThreadPool>,
-    /// Threads of the per-step parallel force pass (same count as `pool`).
-    team: Team,
+    /// Threads of the per-step parallel force pass, which also run the drift of an unfused step and the neighbour
+    /// lists' work (shared with that work through the `Arc`).
+    team: Arc<Team>,
     pub timers: StageTimers,
     /// The gas, when the scenario has one. Its forces on the particles (under the frozen gas field) are
     /// evaluated once per step, at the new positions and half-step velocities, and loaded into the force arrays
@@ -163,8 +163,7 @@ impl Simulation {
             net_force: None,
             accumulators_zeroed: false,
             steps_since_rebalance: 0,
-            pool: make_pool(threads),
-            team: Team::new(threads),
+            team: Arc::new(Team::new(threads)),
             timers: StageTimers::default(),
         };
         sim.refresh_neighbors();
@@ -201,11 +200,11 @@ impl Simulation {
             net_force: state.net_force,
             accumulators_zeroed: false,
             steps_since_rebalance: 0,
-            pool: make_pool(threads),
-            team: Team::new(threads),
+            team: Arc::new(Team::new(threads)),
             timers: StageTimers::default(),
         };
-        sim.on_list_threads(true, |sim| sim.build_lists(true));
+        let team = Arc::clone(&sim.team);
+        sim.build_lists(true, (team.size() > 1).then_some(&*team));
         let layout = sim.config.contact_law.history_layout();
         let (history, orphans) = AlignedHistory::from_store(&state.contacts, &sim.list, layout);
         if orphans > 0 {
@@ -307,8 +306,8 @@ impl Simulation {
 
     /// Advances `n` steps.
     pub fn run_steps(&mut self, n: u64) -> Result<(), NumericalError> {
-        // The force pass runs on the team and list rebuilds on the rayon pool, each handing over only when it runs
-        // (a hand-over to a sleeping thread costs a wake-up). Every step
+        // The force pass and the list rebuilds run on the team, whose helpers spin between them (a hand-over to a
+        // sleeping thread costs a wake-up) and park when this returns. Every step
         // but the last hands its first half (kick + drift) of the next step to its own force loop; the state is
         // a whole step again when this returns.
         let result = (0..n).try_for_each(|k| {
@@ -372,13 +371,19 @@ impl Simulation {
             Some(d2) => d2,
             None => {
                 let g0 = config.gravity.at(self.time_s);
-                let parallel = self.threads() > 1;
                 let (particles, inverse, reference) =
                     (&mut self.particles, &self.inverse, self.list.reference_positions());
-                let (pseudo_2d, domain) = (config.pseudo_2d, config.domain);
-                let mut drift =
-                    move || kick_drift(particles, inverse, &g0, dt, pseudo_2d, &domain, reference, parallel);
-                if parallel { self.pool.install(drift) } else { drift() }
+                let team = Some(&*self.team);
+                kick_drift(
+                    particles,
+                    inverse,
+                    &g0,
+                    dt,
+                    config.pseudo_2d,
+                    &config.domain,
+                    reference,
+                    team,
+                )
             }
         };
         for (angle, wall) in self.wall_angle_rad.iter_mut().zip(&config.walls) {
@@ -425,7 +430,7 @@ impl Simulation {
             let t = Instant::now();
             // On the force pass's team, whose helpers are still spinning from the previous step (a rayon pool's
             // sleeping workers took tens of µs to wake, more than the work of a few thousand particles).
-            let team = (p.len() >= PARALLEL_FLUID_FORCES_MIN_PARTICLES).then_some(&self.team);
+            let team = (p.len() >= PARALLEL_FLUID_FORCES_MIN_PARTICLES).then_some(&*self.team);
             fluid.add_forces(&p.position_m, &p.velocity_m_per_s, &p.radius_m, &mut p.force_n, team);
             if let Some(tally) = self.net_force.as_mut() {
                 // The arrays were zero: they hold exactly the gas's forces.
@@ -593,14 +598,12 @@ impl Simulation {
     fn refresh_neighbors(&mut self) {
         let old_list = std::mem::take(&mut self.list);
         self.list.builds = old_list.builds;
-        // A cell search runs on the pool with several threads; a refilter is too short to be worth the hand-over
-        // (and the force pass's helpers keep spinning through it).
-        let search = self.needs_cell_search();
-        let (history, orphans) = self.on_list_threads(search, |s| {
-            s.build_lists(search);
-            s.history
-                .remap(&old_list, &s.list, s.config.contact_law.history_layout())
-        });
+        // On the force pass's team, whose helpers are spinning from the last pass (no wake-up to pay).
+        let team = Arc::clone(&self.team);
+        let team = (team.size() > 1).then_some(&*team);
+        self.build_lists(self.needs_cell_search(), team);
+        let layout = self.config.contact_law.history_layout();
+        let (history, orphans) = self.history.remap(&old_list, &self.list, layout, team);
         // A contact is always a candidate of a list built from the same positions.
         debug_assert_eq!(orphans, 0, "contacts lost in a neighbour-list rebuild");
         self.history = history;
@@ -631,8 +634,8 @@ impl Simulation {
     }
 
     /// Brings `list` up to date with the current positions, with a cell search when `searched` (which must be
-    /// true whenever [`Simulation::needs_cell_search`] is).
-    fn build_lists(&mut self, searched: bool) {
+    /// true whenever [`Simulation::needs_cell_search`] is), on `team` if given.
+    fn build_lists(&mut self, searched: bool, team: Option<&Team>) {
         let c = &self.config;
         let outer = Criteria {
             domain: &c.domain,
@@ -645,11 +648,11 @@ impl Simulation {
             pseudo_2d: c.pseudo_2d,
         };
         if !self.two_level() {
-            self.list.build(&outer);
+            self.list.build(&outer, team);
             return;
         }
         if searched {
-            self.candidates.build(&outer);
+            self.candidates.build(&outer, team);
         } else {
             self.refilters += 1;
         }
@@ -657,29 +660,12 @@ impl Simulation {
             skin_m: c.inner_skin_m,
             ..outer
         };
-        self.list.refilter(&self.candidates, &inner);
+        self.list.refilter(&self.candidates, &inner, team);
         if searched && c.inner_skin_auto && 2 * self.list.pair_count() > self.candidates.pair_count() {
             // The inner skin does not halve the pairs the force pass examines (a loose or fast bed): refilters
             // would cost more than they save, so one level until the next cell search.
             self.list.adopt(&self.candidates);
         }
-    }
-
-    /// Runs neighbour-list work: on the rayon pool when `parallel` and there are several threads (parking the force
-    /// pass's helpers first so that they do not spin on its cores), else on this thread (see
-    /// `neighbor::on_pool_thread`).
-    fn on_list_threads<R: Send>(&mut self, parallel: bool, f: impl FnOnce(&mut Self) -> R + Send) -> R {
-        if parallel && self.threads() > 1 {
-            self.team.rest();
-            self.with_pool(f)
-        } else {
-            f(self)
-        }
-    }
-
-    fn with_pool<R: Send>(&mut self, f: impl FnOnce(&mut Self) -> R + Send) -> R {
-        let pool = Arc::clone(&self.pool);
-        pool.install(|| f(self))
     }
 
     /// Elastic energy stored in the active contacts, J: (8/15) E* √R* δ^{5/2} for Hertzian contacts that have not
@@ -731,15 +717,4 @@ impl Simulation {
         }
         (top, sum / p.len().max(1) as f64)
     }
-}
-
-/// Every simulation runs in its own pool, so that "one thread" really is one (rayon's global pool would use every
-/// core for the per-particle loops).
-fn make_pool(threads: usize) -> Arc<rayon::ThreadPool> {
-    Arc::new(
-        rayon::ThreadPoolBuilder::new()
-            .num_threads(threads.max(1))
-            .build()
-            .expect("a rayon pool of a few threads can always be built"),
-    )
 }

@@ -3,8 +3,9 @@
 //! A step takes about a millisecond, and a general-purpose pool's sleeping worker takes tens of microseconds to wake
 //! (more in a virtual machine), which measurably limited the two-thread speed-up. Here the helpers spin for a short
 //! while after each job, so a job that follows within that time starts at once; past it they park on a condition
-//! variable and cost nothing. [`Team::rest`] parks them at once, before work that uses another pool (the neighbour
-//! rebuild uses rayon), so that spinning helpers do not compete with it for cores.
+//! variable and cost nothing. The neighbour lists' work and the drift of a step that is not fused into the force pass
+//! run on the same team. [`Team::rest`] parks the helpers at once (a simulation does so when `run_steps` returns), so
+//! that spinning helpers do not compete for cores with whatever the caller does next.
 //!
 //! Thread r of a job always gets index r (the caller is index 0), so a job can hand each index its own part of the
 //! data; which thread runs which part never affects results.
