@@ -20,7 +20,7 @@ use super::contacts::{AlignedHistory, ColumnsMut, split_at_ends};
 use super::geometry::Wall;
 use super::integrate::{InverseInertia, half_kick_one};
 use super::models::{ContactKinematics, ContactLaw, PairTable};
-use super::neighbor::NeighborList;
+use super::neighbor::{BUILD_CHUNK, NeighborList, map_indices};
 use super::particles::{ParticleId, Particles, SpeciesId};
 use super::simulation::SimConfig;
 use super::team::Team;
@@ -725,7 +725,14 @@ impl RangePlan {
 
     /// A plan of `ranges` parts of equal cost, where the cost of each particle is its estimate scaled by the
     /// measured time per unit of estimate of the range that held it in `previous` (when that plan has timings).
-    pub fn balanced(list: &NeighborList, touching: &[bool], ranges: usize, previous: Option<&RangePlan>) -> RangePlan {
+    /// The per-particle estimates (a pass over every pair slot) are made on `team` when given.
+    pub fn balanced(
+        list: &NeighborList,
+        touching: &[bool],
+        ranges: usize,
+        previous: Option<&RangePlan>,
+        team: Option<&Team>,
+    ) -> RangePlan {
         let n = list.start.len().saturating_sub(1);
         let ranges = ranges.clamp(1, n.max(1));
         if ranges == 1 {
@@ -749,7 +756,7 @@ impl RangePlan {
             let mean = per_unit.iter().sum::<f64>() / per_unit.len().max(1) as f64;
             (mean > 0.0 && per_unit.iter().all(|&u| u > 0.0)).then(|| per_unit.iter().map(|u| u / mean).collect())
         });
-        let estimated: Vec<f64> = (0..n).map(|i| Self::particle_cost(list, touching, i)).collect();
+        let estimated: Vec<f64> = map_indices(team, n, BUILD_CHUNK, |i| Self::particle_cost(list, touching, i));
         let mut cost = Vec::with_capacity(n);
         let mut old_range = 0;
         for (i, &e) in estimated.iter().enumerate() {

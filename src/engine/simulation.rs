@@ -591,6 +591,7 @@ impl Simulation {
             &self.history.pair.touching,
             RangePlan::ranges_for(self.threads()),
             Some(&self.ranges),
+            Some(&*self.team),
         );
         self.steps_since_rebalance = 0;
     }
