@@ -461,6 +461,15 @@ struct Tally {
     max_displacement2: f64,
 }
 
+impl Tally {
+    /// Adds what a later loop over other particles found.
+    fn merge(&mut self, later: Tally) {
+        self.worst = self.worst.max(later.worst);
+        self.velocity_sum += later.velocity_sum;
+        self.max_displacement2 = self.max_displacement2.max(later.max_displacement2);
+    }
+}
+
 impl Default for Tally {
     fn default() -> Self {
         Tally {
@@ -664,17 +673,9 @@ fn serial<const WB: bool, const TH: bool>(
     }
     let window = ListWindow::new(list, 0, n);
     let motion = (&mut *position, &mut *velocity, &mut *omega);
-    let tally = sweep::<WB, TH>(
-        ctx,
-        &window,
-        0,
-        0..n,
-        motion,
-        force,
-        torque,
-        history.pair.view(),
-        history.wall.view(),
-    );
+    let no_buffers = PairBuffers::default();
+    let (pairs, walls) = (history.pair.view(), history.wall.view());
+    let tally = sweep::<WB, TH, false>(ctx, &window, 0, 0..n, motion, force, torque, pairs, walls, &no_buffers);
     ForcePass {
         worst_overlap: tally.worst,
         non_finite: first_non_finite(tally.velocity_sum, velocity, omega, 0),
@@ -964,13 +965,15 @@ fn parallel<const WB: bool, const TH: bool>(
     }
 }
 
-/// The serial loop of the force pass over `particles` (window-relative indices, partners `lo` below their global
-/// index; each partner lies within the window): each particle's pairs, scattered to both particles, then its
-/// walls and [`Context::complete`]. The whole pass on one thread; on several, the interior of each range (all but
-/// its boundary layer, see [`range_sweep`]). One function for both, so both run the same machine code.
+/// The serial loop of the force pass over `particles` of a window of the list (indices relative to the window;
+/// partner indices are global and `lo` is subtracted from them): each particle's pairs, scattered to both
+/// particles, then its walls and [`Context::complete`]. On one thread the whole pass, with `CROSS` false. On several,
+/// each range (see [`range_sweep`]): its interior with `CROSS` false, and its boundary layer with `CROSS` true, where
+/// a partner beyond the window is not evaluated but its result taken from `buffers` (phase A of [`parallel`]). One
+/// function for all, so the interior of a range runs the same machine code as the one-thread pass.
 #[allow(clippy::too_many_arguments)]
 #[inline(never)]
-fn sweep<const WB: bool, const TH: bool>(
+fn sweep<const WB: bool, const TH: bool, const CROSS: bool>(
     ctx: Context,
     window: &ListWindow,
     lo: usize,
@@ -980,22 +983,32 @@ fn sweep<const WB: bool, const TH: bool>(
     torque: &mut [Vec3],
     mut pairs: ColumnsMut,
     mut walls: ColumnsMut,
+    buffers: &PairBuffers,
 ) -> Tally {
     // Everything the loop touches is a local or a parameter slice (not reached through a reference to a struct),
     // which lets the compiler keep the slices' pointers in registers across the stores to `force`.
     let motion = &Cells::new(x, v, w, 0);
     let (pairs, walls) = (&mut pairs, &mut walls);
+    let local_hi = force.len();
     let mut tally = Tally::default();
     for il in particles {
         let slots = window.pairs_of(il);
         let bi = ctx.body(il, motion);
         for (k, &j) in slots.clone().zip(&window.partner[slots]) {
             let j = j as usize - lo;
-            if let Some(res) = ctx.pair::<WB, TH>(il, &bi, j, motion, pairs, k, &mut tally.worst) {
-                force[il] += res.force;
-                force[j] -= res.force;
-                torque[il] += res.torque_i;
-                torque[j] += res.torque_j;
+            if !CROSS || j < local_hi {
+                if let Some(res) = ctx.pair::<WB, TH>(il, &bi, j, motion, pairs, k, &mut tally.worst) {
+                    force[il] += res.force;
+                    force[j] -= res.force;
+                    torque[il] += res.torque_i;
+                    torque[j] += res.torque_j;
+                }
+            } else {
+                let k = k + window.pair_base;
+                if buffers.touching[k] {
+                    force[il] += buffers.force_on_i[k];
+                    torque[il] += buffers.torque_on_i[k];
+                }
             }
         }
         let wall_slots = window.walls_of(il);
@@ -1122,7 +1135,8 @@ fn range_sweep<const WB: bool, const TH: bool>(
     let local_hi = hi - lo;
     let cross_from = plan.cross_from[r] - lo;
     let interior = (&mut *x, &mut *v, &mut *w);
-    let mut tally = sweep::<WB, TH>(
+    let (interior_pairs, interior_walls) = (pairs.reborrow(), walls.reborrow());
+    let mut tally = sweep::<WB, TH, false>(
         ctx,
         &window,
         lo,
@@ -1130,45 +1144,23 @@ fn range_sweep<const WB: bool, const TH: bool>(
         interior,
         force,
         torque,
-        pairs.reborrow(),
-        walls.reborrow(),
+        interior_pairs,
+        interior_walls,
+        buffers,
     );
-    let motion = Cells::new(x, v, w, 0);
-    // The boundary layer: partners beyond the range come from the buffers of phase A.
-    for il in cross_from..local_hi {
-        let slots = window.pairs_of(il);
-        let bi = ctx.body(il, &motion);
-        for (k, &j) in slots.clone().zip(&window.partner[slots]) {
-            let j = j as usize - lo;
-            if j < local_hi {
-                if let Some(res) = ctx.pair::<WB, TH>(il, &bi, j, &motion, &mut pairs, k, &mut tally.worst) {
-                    force[il] += res.force;
-                    force[j] -= res.force;
-                    torque[il] += res.torque_i;
-                    torque[j] += res.torque_j;
-                }
-            } else {
-                let k = k + window.pair_base;
-                if buffers.touching[k] {
-                    force[il] += buffers.force_on_i[k];
-                    torque[il] += buffers.torque_on_i[k];
-                }
-            }
-        }
-        let wall_slots = window.walls_of(il);
-        let (f, t) = ctx.complete::<WB, TH>(
-            il,
-            force[il],
-            torque[il],
-            &motion,
-            &window.wall_partner[wall_slots.clone()],
-            &mut walls,
-            wall_slots.start,
-            &mut tally,
-        );
-        force[il] = f;
-        torque[il] = t;
-    }
+    let layer = sweep::<WB, TH, true>(
+        ctx,
+        &window,
+        lo,
+        cross_from..local_hi,
+        (x, v, w),
+        force,
+        torque,
+        pairs,
+        walls,
+        buffers,
+    );
+    tally.merge(layer);
     tally.worst.shift_particles(lo, config.walls.len());
     (
         tally.worst,
