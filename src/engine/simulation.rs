@@ -204,7 +204,7 @@ impl Simulation {
             timers: StageTimers::default(),
         };
         let team = Arc::clone(&sim.team);
-        sim.build_lists(true, (team.size() > 1).then_some(&*team));
+        sim.build_lists(true, Some(&*team));
         let layout = sim.config.contact_law.history_layout();
         let (history, orphans) = AlignedHistory::from_store(&state.contacts, &sim.list, layout);
         if orphans > 0 {
@@ -600,8 +600,9 @@ impl Simulation {
         let old_list = std::mem::take(&mut self.list);
         self.list.builds = old_list.builds;
         // On the force pass's team, whose helpers are spinning from the last pass (no wake-up to pay).
+        // (A one-thread team runs everything on this thread.)
         let team = Arc::clone(&self.team);
-        let team = (team.size() > 1).then_some(&*team);
+        let team = Some(&*team);
         self.build_lists(self.needs_cell_search(), team);
         let layout = self.config.contact_law.history_layout();
         let (history, orphans) = self.history.remap(&old_list, &self.list, layout, team);
