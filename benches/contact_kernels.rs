@@ -16,7 +16,7 @@ fn kernels(c: &mut Criterion) {
         friction_coefficient: 0.3,
         yield_force_n: 0.05,
         rolling_friction_coefficient: 0.0,
-        viscoelastic_beta: 0.0,
+        hertz_damping_factor_pa: 0.0,
         tangential_damping_ratio: 1.0,
     };
     let k = ContactKinematics {
@@ -25,6 +25,8 @@ fn kernels(c: &mut Criterion) {
         effective_radius_m: 7.5e-4,
         effective_mass_kg: 1.77e-5,
         contact_velocity: Vec3::new(0.01, -0.02, 0.003),
+        // contact_velocity · normal
+        normal_velocity_m_per_s: -0.0096,
         relative_angular_velocity: Vec3::new(0.1, 0.2, -0.3),
     };
     let laws = [

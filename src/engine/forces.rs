@@ -296,18 +296,25 @@ impl<'a> Context<'a> {
             return None;
         }
         let dist = dist2.sqrt();
-        let n = d * (1.0 / dist);
+        let inv_dist = 1.0 / dist;
+        let n = d * inv_dist;
+        let dv = bi.v - vel.v(j);
         let overlap = reach - dist;
         // Not `f64::min`: radii are never NaN, and its NaN handling costs five instructions per contact.
         worst.note(overlap, if ri < rj { ri } else { rj }, i, j as u32);
         let (wi, wj) = (bi.w, vel.w(j));
         let (mi, mj) = (bi.mass_kg, self.mass_kg[j]);
+        // R* = r_i r_j/(r_i + r_j) and m* = m_i m_j/(m_i + m_j) from one division: divisions share a unit with
+        // the square roots of the contact's critical path.
+        let mass_sum = mi + mj;
+        let inv_reach_mass_sum = 1.0 / (reach * mass_sum);
         let kin = ContactKinematics {
             normal: n,
             overlap_m: overlap,
-            effective_radius_m: ri * rj / reach,
-            effective_mass_kg: mi * mj / (mi + mj),
-            contact_velocity: bi.v - vel.v(j) - (wi * ri + wj * rj).cross(&n),
+            effective_radius_m: ri * rj * (mass_sum * inv_reach_mass_sum),
+            effective_mass_kg: mi * mj * (reach * inv_reach_mass_sum),
+            contact_velocity: dv - (wi * ri + wj * rj).cross(&n),
+            normal_velocity_m_per_s: dv.dot(&d) * inv_dist,
             relative_angular_velocity: wi - wj,
         };
         let mat = self.table.get(bi.species, self.species[j]);
@@ -357,6 +364,7 @@ impl<'a> Context<'a> {
                 effective_radius_m: ri,
                 effective_mass_kg: self.mass_kg[i],
                 contact_velocity: vi - (wi * ri).cross(&n) - prox.wall_velocity,
+                normal_velocity_m_per_s: (vi - prox.wall_velocity).dot(&n),
                 relative_angular_velocity: wi - prox.wall_angular_velocity,
             };
             let mat = self.table.get(self.species[i], wall.species);

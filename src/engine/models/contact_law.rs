@@ -33,6 +33,10 @@ pub struct ContactKinematics {
     pub effective_mass_kg: f64,
     /// Velocity of i's contact point minus that of the partner's contact point.
     pub contact_velocity: Vec3,
+    /// Its normal component `contact_velocity · normal`, negative while approaching. The caller forms it from the
+    /// centres' velocities alone (the rotational part of the contact velocity is normal to n), which keeps it off
+    /// the chain of dependent operations that sets the force loop's speed.
+    pub normal_velocity_m_per_s: f64,
     /// ω_i − ω_j (for a wall, ω_i minus the wall's own rotation).
     pub relative_angular_velocity: Vec3,
 }
@@ -73,7 +77,7 @@ impl ContactLaw {
         hist: &mut ContactHistory,
     ) -> ContactOutput {
         let n = k.normal;
-        let vn = k.contact_velocity.dot(&n);
+        let vn = k.normal_velocity_m_per_s;
         let normal = self
             .normal
             .force(mat, k.effective_radius_m, k.effective_mass_kg, k.overlap_m, vn, hist);

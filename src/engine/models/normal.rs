@@ -11,7 +11,7 @@ use super::history::ContactHistory;
 use super::pair_table::PairMaterial;
 
 /// √(5/6), from the Tsuji/LIGGGHTS viscoelastic damping coefficient.
-const SQRT_FIVE_SIXTHS: f64 = 0.912_870_929_175_276_8;
+pub(super) const SQRT_FIVE_SIXTHS: f64 = 0.912_870_929_175_276_8;
 
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize, schemars::JsonSchema)]
 #[serde(rename_all = "snake_case", deny_unknown_fields)]
@@ -85,13 +85,14 @@ impl NormalModel {
                 viscoelastic_damping_kg_per_s: 0.0,
             },
             NormalModel::Hertz { .. } => {
+                // Ordered for the latency of the chain of dependent operations from δ to F_n, which sets the force
+                // loop's speed: k_n δ = a (4/3 E* δ) and γ_n = √(F m* a) with F = (2√(5/6) β)² 2E* from the pair
+                // table.
                 let contact_radius = (effective_radius_m * overlap_m).sqrt();
-                let e_star = mat.effective_youngs_modulus_pa;
-                let kn = 4.0 / 3.0 * e_star * contact_radius;
-                let sn = 2.0 * e_star * contact_radius;
-                let gamma_n = 2.0 * SQRT_FIVE_SIXTHS * mat.viscoelastic_beta * (sn * effective_mass_kg).sqrt();
+                let elastic_per_a = 4.0 / 3.0 * mat.effective_youngs_modulus_pa * overlap_m;
+                let gamma_n = (mat.hertz_damping_factor_pa * effective_mass_kg * contact_radius).sqrt();
                 NormalOutput {
-                    force_n: kn * overlap_m - gamma_n * normal_velocity_m_per_s,
+                    force_n: (-gamma_n).mul_add(normal_velocity_m_per_s, contact_radius * elastic_per_a),
                     contact_radius_m: contact_radius,
                     viscoelastic_damping_kg_per_s: gamma_n,
                 }
@@ -233,7 +234,7 @@ mod tests {
             friction_coefficient: 0.3,
             yield_force_n: 0.5,
             rolling_friction_coefficient: 0.0,
-            viscoelastic_beta: 0.0,
+            hertz_damping_factor_pa: 0.0,
             tangential_damping_ratio: 1.0,
         }
     }

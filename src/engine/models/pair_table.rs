@@ -4,7 +4,7 @@
 //! `forces.rs`. Walls are species too: a particle–wall pair uses the (particle species, wall species) entry.
 
 use super::contact_law::ContactLaw;
-use super::normal::{NormalModel, damping_beta};
+use super::normal::{NormalModel, SQRT_FIVE_SIXTHS, damping_beta};
 use crate::engine::particles::{SpeciesId, SpeciesTable};
 
 /// Mixed material properties of one species pair.
@@ -20,9 +20,10 @@ pub struct PairMaterial {
     pub yield_force_n: f64,
     /// Rolling-resistance coefficient μ_r of the pair.
     pub rolling_friction_coefficient: f64,
-    /// Hertz viscoelastic damping ratio β = |ln e| / √(ln² e + π²) of the contact law's restitution (0 for other
-    /// normal models). Precomputed: a logarithm per contact per step is a measurable share of the force loop.
-    pub viscoelastic_beta: f64,
+    /// (2√(5/6) β)² 2E*, with β = |ln e| / √(ln² e + π²) the Hertz viscoelastic damping ratio of the contact law's
+    /// restitution (0 for other normal models), so that the Hertz damping γ_n = 2√(5/6) β √(S_n m*), S_n = 2E* a,
+    /// is √(this · m* a). Precomputed: a logarithm per contact per step is a measurable share of the force loop.
+    pub hertz_damping_factor_pa: f64,
     /// √(4G*/E*) = √(k_t/S_n): Mindlin's tangential damping is the normal one times this (LIGGGHTS' γ_t/γ_n).
     pub tangential_damping_ratio: f64,
 }
@@ -56,10 +57,11 @@ impl PairTable {
                     (Some(x), None) | (None, Some(x)) => x,
                     (None, None) => f64::INFINITY,
                 };
+                let damping_coefficient = 2.0 * SQRT_FIVE_SIXTHS * viscoelastic_beta;
                 entries.push(PairMaterial {
+                    hertz_damping_factor_pa: damping_coefficient * damping_coefficient * 2.0 / inv_e,
                     effective_youngs_modulus_pa: 1.0 / inv_e,
                     effective_shear_modulus_pa: 1.0 / inv_g,
-                    viscoelastic_beta,
                     tangential_damping_ratio: (4.0 * inv_e / inv_g).sqrt(),
                     friction_coefficient: 0.5 * (a.friction_coefficient + b.friction_coefficient),
                     yield_force_n,

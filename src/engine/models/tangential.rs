@@ -68,7 +68,7 @@ impl TangentialModel {
                 damping_kg_per_s,
             } => spring_with_coulomb_limit(
                 stiffness_n_per_m,
-                damping_kg_per_s,
+                tangential_velocity * damping_kg_per_s,
                 limit,
                 n,
                 tangential_velocity,
@@ -78,8 +78,11 @@ impl TangentialModel {
             TangentialModel::Mindlin => {
                 let kt = 8.0 * mat.effective_shear_modulus_pa * normal.contact_radius_m;
                 // γ_t = 2√(5/6) β √(k_t m*) = γ_n √(k_t/S_n) (LIGGGHTS), with √(k_t/S_n) = √(4G*/E*) per pair.
-                let gamma_t = normal.viscoelastic_damping_kg_per_s * mat.tangential_damping_ratio;
-                spring_with_coulomb_limit(kt, gamma_t, limit, n, tangential_velocity, dt_s, hist)
+                // The dashpot force γ_t v_t is formed as (v_t √(k_t/S_n)) γ_n: γ_n comes last in the chain of
+                // dependent operations that sets the force loop's speed, so it gets one multiplication, not two.
+                let viscous =
+                    (tangential_velocity * mat.tangential_damping_ratio) * normal.viscoelastic_damping_kg_per_s;
+                spring_with_coulomb_limit(kt, viscous, limit, n, tangential_velocity, dt_s, hist)
             }
             TangentialModel::WaltonBraun { exponent } => {
                 // CHOICE: k_t0 = k_n (1−ν)/(1−ν/2) (2.13) with k_n the current Hertz tangent stiffness
@@ -92,11 +95,11 @@ impl TangentialModel {
     }
 }
 
-/// Elastic displacement spring with a dashpot, truncated to the Coulomb limit.
+/// Elastic displacement spring with a dashpot (whose force is `viscous` = γ_t v_t), truncated to the Coulomb limit.
 #[inline]
 fn spring_with_coulomb_limit(
     stiffness: f64,
-    damping: f64,
+    viscous: Vec3,
     limit: f64,
     n: &Vec3,
     tangential_velocity: &Vec3,
@@ -104,14 +107,14 @@ fn spring_with_coulomb_limit(
     hist: &mut ContactHistory,
 ) -> Vec3 {
     let displacement = rotate_into_tangent_plane(hist.tangential, n) + tangential_velocity * dt_s;
-    let trial = -(displacement * stiffness) - tangential_velocity * damping;
+    let trial = -(displacement * stiffness) - viscous;
     let trial_mag2 = trial.norm_squared();
     if trial_mag2 > limit * limit {
         // Sliding: the force sits on the Coulomb limit and the spring is reset to what that force implies
         // (Cundall-Strack; LAMMPS granular).
         let force = trial * (limit / trial_mag2.sqrt());
         hist.tangential = if stiffness > 0.0 {
-            -(force + tangential_velocity * damping) / stiffness
+            -(force + viscous) / stiffness
         } else {
             Vec3::zeros()
         };
@@ -179,7 +182,7 @@ mod tests {
             friction_coefficient: 0.5,
             yield_force_n: f64::INFINITY,
             rolling_friction_coefficient: 0.0,
-            viscoelastic_beta: 0.0,
+            hertz_damping_factor_pa: 0.0,
             tangential_damping_ratio: 1.0,
         }
     }
