@@ -335,7 +335,7 @@ impl AlignedHistory {
         old_list: &NeighborList,
         new_list: &NeighborList,
         layout: HistoryLayout,
-        team: Option<&Team>,
+        team: &Team,
     ) -> (AlignedHistory, usize) {
         if old_list.start.len() != new_list.start.len() {
             // A different particle set (or no list yet): go through the keyed store.
@@ -376,15 +376,15 @@ impl AlignedHistory {
             }
             orphans
         };
-        // On the simulation's team if given, else on the calling thread.
         let chunks = pair
             .split(&pair_ends)
             .into_iter()
             .zip(wall.split(&wall_ends))
             .enumerate();
-        let orphans: usize = match team {
-            Some(team) if team.size() > 1 => team.map_parts(chunks.collect(), |_, c| merge(c)).into_iter().sum(),
-            _ => chunks.map(merge).sum(),
+        let orphans: usize = if team.size() > 1 {
+            team.map_parts(chunks.collect(), |_, c| merge(c)).into_iter().sum()
+        } else {
+            chunks.map(merge).sum()
         };
         (AlignedHistory { pair, wall }, orphans)
     }

@@ -20,7 +20,7 @@ use super::contacts::{AlignedHistory, ColumnsMut, split_at_ends};
 use super::geometry::Wall;
 use super::integrate::{InverseInertia, half_kick_one};
 use super::models::{ContactKinematics, ContactLaw, PairTable};
-use super::neighbor::{BUILD_CHUNK, NeighborList, map_indices};
+use super::neighbor::{BUILD_CHUNK, NeighborList};
 use super::particles::{ParticleId, Particles, SpeciesId};
 use super::simulation::SimConfig;
 use super::team::Team;
@@ -732,15 +732,45 @@ impl RangePlan {
         1.0 + 0.25 * slots.len() as f64 + 2.0 * contacts as f64
     }
 
+    /// Calls `f(i, estimate, cost)` for each particle i of `particles` in order: its estimated cost and that
+    /// estimate scaled by the measured speed of the range of `old` (bounds and relative time per unit) that held it.
+    #[inline]
+    fn visit_costs(
+        list: &NeighborList,
+        touching: &[bool],
+        old: Option<(&[usize], &[f64])>,
+        particles: std::ops::Range<usize>,
+        mut f: impl FnMut(usize, f64, f64),
+    ) {
+        let mut old_range = old.map_or(0, |(bounds, _)| bounds.partition_point(|&b| b <= particles.start) - 1);
+        for i in particles {
+            let estimate = Self::particle_cost(list, touching, i);
+            let cost = match old {
+                Some((bounds, speed)) => {
+                    while i >= bounds[old_range + 1] {
+                        old_range += 1;
+                    }
+                    estimate * speed[old_range]
+                }
+                None => estimate,
+            };
+            f(i, estimate, cost);
+        }
+    }
+
     /// A plan of `ranges` parts of equal cost, where the cost of each particle is its estimate scaled by the
     /// measured time per unit of estimate of the range that held it in `previous` (when that plan has timings).
-    /// The per-particle estimates (a pass over every pair slot) are made on `team` when given.
+    ///
+    /// Made at every neighbour-list rebuild, so it must cost little next to a step: one pass over every pair slot,
+    /// in chunks on `team`, gives each chunk's summed estimate and cost and the furthest partner of its particles;
+    /// the bounds, the first particle of each range with a partner beyond it and each range's estimate then need
+    /// only the chunk sums and a scan of the few chunks where a bound falls.
     pub fn balanced(
         list: &NeighborList,
         touching: &[bool],
         ranges: usize,
         previous: Option<&RangePlan>,
-        team: Option<&Team>,
+        team: &Team,
     ) -> RangePlan {
         let n = list.start.len().saturating_sub(1);
         let ranges = ranges.clamp(1, n.max(1));
@@ -765,48 +795,87 @@ impl RangePlan {
             let mean = per_unit.iter().sum::<f64>() / per_unit.len().max(1) as f64;
             (mean > 0.0 && per_unit.iter().all(|&u| u > 0.0)).then(|| per_unit.iter().map(|u| u / mean).collect())
         });
-        let estimated: Vec<f64> = map_indices(team, n, BUILD_CHUNK, |i| Self::particle_cost(list, touching, i));
-        let mut cost = Vec::with_capacity(n);
-        let mut old_range = 0;
-        for (i, &e) in estimated.iter().enumerate() {
-            let mut c = e;
-            if let (Some(speed), Some(p)) = (&speed, previous) {
-                while i >= p.bounds[old_range + 1] {
-                    old_range += 1;
-                }
-                c *= speed[old_range];
-            }
-            cost.push(c);
+        let old = speed.as_deref().zip(previous).map(|(speed, p)| (&p.bounds[..], speed));
+        let last_partner = |i: usize| list.pairs_of(i).next_back().map_or(0, |k| list.partner[k] as usize);
+        struct ChunkCost {
+            estimate: f64,
+            cost: f64,
+            /// The largest partner index of the chunk's particles (0: none; a partner is never particle 0).
+            last_partner: usize,
         }
-        let total: f64 = cost.iter().sum();
+        let chunks: Vec<ChunkCost> = team.map_chunks(n, BUILD_CHUNK, |particles| {
+            let mut sum = ChunkCost {
+                estimate: 0.0,
+                cost: 0.0,
+                last_partner: 0,
+            };
+            Self::visit_costs(list, touching, old, particles, |i, estimate, cost| {
+                sum.estimate += estimate;
+                sum.cost += cost;
+                sum.last_partner = sum.last_partner.max(last_partner(i));
+            });
+            sum
+        });
+        let chunk_of = |c: usize| c * BUILD_CHUNK..((c + 1) * BUILD_CHUNK).min(n);
+
+        // Bound k is the first particle before which the summed cost reaches k/ranges of the total.
+        let total: f64 = chunks.iter().map(|c| c.cost).sum();
+        let target = |k: usize| total * k as f64 / ranges as f64;
         let mut bounds = vec![0usize];
-        let mut running = 0.0;
-        let mut next = 1;
-        for (i, c) in cost.iter().enumerate() {
-            while next < ranges && running >= total * next as f64 / ranges as f64 {
-                bounds.push(i);
-                next += 1;
+        let (mut running, mut next) = (0.0, 1);
+        for (c, chunk) in chunks.iter().enumerate() {
+            if next >= ranges {
+                break;
             }
-            running += c;
+            if running + chunk.cost < target(next) {
+                running += chunk.cost;
+                continue;
+            }
+            Self::visit_costs(list, touching, old, chunk_of(c), |i, _, cost| {
+                while next < ranges && running >= target(next) {
+                    bounds.push(i);
+                    next += 1;
+                }
+                running += cost;
+            });
         }
         while bounds.len() < ranges {
             bounds.push(n);
         }
         bounds.push(n);
+
         let cross_from: Vec<usize> = (0..ranges)
             .map(|r| {
                 let (lo, hi) = (bounds[r], bounds[r + 1]);
-                (lo..hi)
-                    .find(|&i| {
-                        list.pairs_of(i)
-                            .next_back()
-                            .is_some_and(|k| list.partner[k] as usize >= hi)
+                if lo >= hi {
+                    return hi;
+                }
+                (lo / BUILD_CHUNK..=(hi - 1) / BUILD_CHUNK)
+                    .filter(|&c| chunks[c].last_partner >= hi)
+                    .find_map(|c| {
+                        let particles = chunk_of(c);
+                        (lo.max(particles.start)..hi.min(particles.end)).find(|&i| last_partner(i) >= hi)
                     })
                     .unwrap_or(hi)
             })
             .collect();
         let estimate = (0..ranges)
-            .map(|r| estimated[bounds[r]..bounds[r + 1]].iter().sum())
+            .map(|r| {
+                let (mut i, hi) = (bounds[r], bounds[r + 1]);
+                let mut sum = 0.0;
+                while i < hi {
+                    let particles = chunk_of(i / BUILD_CHUNK);
+                    if i == particles.start && particles.end <= hi {
+                        sum += chunks[i / BUILD_CHUNK].estimate;
+                    } else {
+                        sum += (i..particles.end.min(hi))
+                            .map(|k| Self::particle_cost(list, touching, k))
+                            .sum::<f64>();
+                    }
+                    i = particles.end.min(hi);
+                }
+                sum
+            })
             .collect();
         // Ranges are scanned in ascending order and each range's particles ascending, so every target range gets
         // its incoming slots in ascending first particle.
@@ -1175,4 +1244,107 @@ fn range_sweep<const WB: bool, const TH: bool>(
         first_non_finite(tally.velocity_sum, v, w, lo),
         tally.max_displacement2,
     )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A list of `n` particles whose partners are mostly near in index (as in a spatially sorted bed), with now and
+    /// then one far away (as across a periodic axis), and a touching flag per slot.
+    fn random_list(n: usize, seed: u64) -> (NeighborList, Vec<bool>) {
+        let mut state = seed;
+        let mut next = move |m: usize| {
+            state = state
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            ((state >> 33) % m as u64) as usize
+        };
+        let mut list = NeighborList::default();
+        list.start.push(0);
+        list.wall_start.resize(n + 1, 0);
+        let mut touching = Vec::new();
+        for i in 0..n {
+            let count = next(6);
+            let mut partners: Vec<u32> = (0..count).map(|_| (i + 1 + next(200)) as u32).collect();
+            if next(50) == 0 {
+                partners.push((i + 1 + next(n)) as u32);
+            }
+            partners.retain(|&j| (j as usize) < n);
+            partners.sort_unstable();
+            partners.dedup();
+            touching.extend(partners.iter().map(|_| next(3) == 0));
+            list.partner.extend(partners);
+            list.start.push(list.partner.len() as u32);
+        }
+        (list, touching)
+    }
+
+    /// The plan made from chunk sums equals what its definition gives particle by particle: bound k is the first
+    /// particle before which the summed (speed-scaled) cost reaches k/ranges of the total, `cross_from` the first
+    /// particle of a range with a partner beyond it, `incoming` every slot whose partner lies in a later range; on one
+    /// thread and on two.
+    #[test]
+    fn balanced_plan_matches_its_definition_particle_by_particle() {
+        for (n, ranges, seed) in [(5000, 4, 1), (3000, 7, 2), (1500, 2, 3), (40, 4, 4)] {
+            let (list, touching) = random_list(n, seed);
+            let first = RangePlan::balanced(&list, &touching, ranges, None, &Team::new(1));
+            // Give the first plan unequal timings, so that the next is scaled by speed.
+            for (r, busy) in first.busy_ns.iter().enumerate() {
+                busy.store(
+                    1000 * (r as u64 + 1) * (first.bounds[r + 1] - first.bounds[r]) as u64 + 1,
+                    Ordering::Relaxed,
+                );
+            }
+            for team in [Team::new(1), Team::new(2)] {
+                let plan = RangePlan::balanced(&list, &touching, ranges, Some(&first), &team);
+                let per_unit: Vec<f64> = first
+                    .busy_ns
+                    .iter()
+                    .zip(&first.estimate)
+                    .map(|(t, e)| t.load(Ordering::Relaxed) as f64 / e.max(1.0))
+                    .collect();
+                let mean = per_unit.iter().sum::<f64>() / per_unit.len() as f64;
+                let old_range = |i: usize| first.bounds.partition_point(|&b| b <= i) - 1;
+                let cost: Vec<f64> = (0..n)
+                    .map(|i| RangePlan::particle_cost(&list, &touching, i) * per_unit[old_range(i)] / mean)
+                    .collect();
+                let total: f64 = cost.iter().sum();
+                assert_eq!(plan.bounds.len(), ranges + 1);
+                assert_eq!((plan.bounds[0], plan.bounds[ranges]), (0, n));
+                for k in 1..ranges {
+                    let b = plan.bounds[k];
+                    let before: f64 = cost[..b].iter().sum();
+                    let target = total * k as f64 / ranges as f64;
+                    assert!(before >= target * (1.0 - 1e-12), "bound {k} = {b} comes too early");
+                    assert!(
+                        b == 0 || before - cost[b - 1] < target * (1.0 + 1e-12),
+                        "bound {k} = {b} comes too late"
+                    );
+                }
+                let last_partner = |i: usize| list.pairs_of(i).next_back().map_or(0, |k| list.partner[k] as usize);
+                let mut incoming = vec![Vec::new(); ranges];
+                for r in 0..ranges {
+                    let (lo, hi) = (plan.bounds[r], plan.bounds[r + 1]);
+                    let expected = (lo..hi).find(|&i| last_partner(i) >= hi).unwrap_or(hi);
+                    assert_eq!(plan.cross_from[r], expected, "range {r} of {ranges}");
+                    let estimate: f64 = (lo..hi).map(|i| RangePlan::particle_cost(&list, &touching, i)).sum();
+                    assert!((plan.estimate[r] - estimate).abs() <= 1e-9 * estimate.max(1.0));
+                    for i in lo..hi {
+                        for k in list.pairs_of(i) {
+                            let j = list.partner[k] as usize;
+                            if j >= hi {
+                                let target = plan.bounds.partition_point(|&b| b <= j) - 1;
+                                incoming[target].push((k as u32, j as u32));
+                            }
+                        }
+                    }
+                }
+                for (r, slots) in incoming.iter().enumerate() {
+                    let got = &plan.incoming[plan.incoming_start[r]..plan.incoming_start[r + 1]];
+                    assert_eq!(got, slots.as_slice(), "incoming slots of range {r}");
+                }
+            }
+        }
+    }
 }

@@ -49,7 +49,7 @@ pub fn half_kick_one(
 
 /// First half of a step: half kick and drift (wrapped on periodic axes). Returns the largest squared displacement
 /// from `reference` (the positions at the last neighbour-list build; empty = skip). With a `team` of several
-/// threads, chunks run on it; without, on the calling thread (per-particle arithmetic, so the same bits).
+/// threads, chunks run on it; with one, on the calling thread (per-particle arithmetic, so the same bits).
 ///
 /// No checks here: velocities were checked finite by the kick that made them (`forces.rs`), so positions stay
 /// finite, and lost particles are looked for when the neighbour list is rebuilt (a particle cannot leave the box
@@ -63,7 +63,7 @@ pub fn kick_drift(
     pseudo_2d: bool,
     domain: &Domain,
     reference: &[Vec3],
-    team: Option<&Team>,
+    team: &Team,
 ) -> f64 {
     let half_dt = 0.5 * dt_s;
     let g_half_dt = gravity * half_dt;
@@ -97,7 +97,7 @@ pub fn kick_drift(
             }
             max_d2
         };
-    let Some(team) = team.filter(|t| t.size() > 1) else {
+    if team.size() == 1 {
         // One chunk covering every particle: the same per-particle arithmetic, and the maximum of the chunk maxima
         // is the maximum.
         return chunk(
@@ -109,7 +109,7 @@ pub fn kick_drift(
             &p.torque_n_m,
             (&inverse.inv_mass_per_kg, &inverse.inv_inertia_per_kg_m2),
         );
-    };
+    }
     let parts: Vec<_> = p
         .position_m
         .chunks_mut(CHUNK)
@@ -128,9 +128,45 @@ pub fn kick_drift(
         .fold(0.0, f64::max)
 }
 
-/// The first particle outside the box by more than `tolerance_m` on a non-periodic axis, or not finite.
-pub fn find_lost(p: &Particles, domain: &Domain, tolerance_m: f64) -> Option<usize> {
-    p.position_m
-        .iter()
-        .position(|x| !(x.x + x.y + x.z).is_finite() || domain.is_lost(x, tolerance_m))
+/// The first particle outside the box by more than `tolerance_m` on a non-periodic axis, or not finite; the
+/// particles are scanned in chunks on `team`.
+pub fn find_lost(position: &[Vec3], domain: &Domain, tolerance_m: f64, team: &Team) -> Option<usize> {
+    let lost = |x: &Vec3| !(x.x + x.y + x.z).is_finite() || domain.is_lost(x, tolerance_m);
+    team.map_chunks(position.len(), CHUNK, |particles| {
+        let lo = particles.start;
+        position[particles].iter().position(lost).map(|k| lo + k)
+    })
+    .into_iter()
+    .flatten()
+    .next()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The first lost or non-finite particle is found wherever it is, also when a later chunk (which a helper thread
+    /// may scan first) holds another.
+    #[test]
+    fn find_lost_reports_the_first_lost_particle_on_any_team() {
+        let domain = Domain::new(Vec3::zeros(), Vec3::new(1.0, 1.0, 1.0), [true, false, false]);
+        let n = 5 * CHUNK + 17;
+        let inside: Vec<Vec3> = (0..n)
+            .map(|i| Vec3::new(2.5, (i as f64 + 0.5) / n as f64, 0.5))
+            .collect();
+        for team in [Team::new(1), Team::new(2), Team::new(3)] {
+            assert_eq!(find_lost(&inside, &domain, 0.01, &team), None, "x is periodic");
+            let mut x = inside.clone();
+            x[4 * CHUNK + 3].y = -0.02;
+            assert_eq!(find_lost(&x, &domain, 0.01, &team), Some(4 * CHUNK + 3));
+            x[CHUNK + 1].z = f64::NAN;
+            assert_eq!(find_lost(&x, &domain, 0.01, &team), Some(CHUNK + 1));
+            x[2].z = 1.005;
+            assert_eq!(
+                find_lost(&x, &domain, 0.01, &team),
+                Some(CHUNK + 1),
+                "within the tolerance"
+            );
+        }
+    }
 }

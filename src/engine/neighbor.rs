@@ -9,28 +9,24 @@
 //! not either.
 
 use super::Vec3;
+use super::contacts::split_at_ends;
 use super::geometry::{Domain, Wall};
 use super::team::Team;
 
 /// Particles per work item in the build.
 pub const BUILD_CHUNK: usize = 1024;
 
-/// `f` over `0..n`, collected in order: on `team`'s threads in parts of `part_len` indices when there is a team of
+/// `f` over `0..n`, collected in order: on `team`'s threads in parts of `part_len` indices when the team has
 /// several threads, else on the calling thread. A simulation passes the force pass's team, whose helpers are still
 /// spinning from the last force pass, so the hand-over costs no thread wake-up. Results are the same either way.
-pub fn map_indices<T: Send>(team: Option<&Team>, n: usize, part_len: usize, f: impl Fn(usize) -> T + Sync) -> Vec<T> {
-    match team {
-        Some(team) if team.size() > 1 && n > part_len => {
-            let parts: Vec<std::ops::Range<usize>> = (0..n.div_ceil(part_len))
-                .map(|k| k * part_len..((k + 1) * part_len).min(n))
-                .collect();
-            let results = team.map_parts(parts, |_, part| part.map(&f).collect::<Vec<T>>());
-            let mut out = Vec::with_capacity(n);
-            results.into_iter().for_each(|mut part| out.append(&mut part));
-            out
-        }
-        _ => (0..n).map(f).collect(),
+pub fn map_indices<T: Send>(team: &Team, n: usize, part_len: usize, f: impl Fn(usize) -> T + Sync) -> Vec<T> {
+    if team.size() == 1 || n <= part_len {
+        return (0..n).map(f).collect();
     }
+    let results = team.map_chunks(n, part_len, |part| part.map(&f).collect::<Vec<T>>());
+    let mut out = Vec::with_capacity(n);
+    results.into_iter().for_each(|mut part| out.append(&mut part));
+    out
 }
 
 /// How far beyond contact particles interact with each other and with walls (a cohesion model's range): the list
@@ -65,7 +61,7 @@ struct CellGrid {
 }
 
 impl CellGrid {
-    fn new(domain: &Domain, position: &[Vec3], cell_size_m: f64, team: Option<&Team>) -> Self {
+    fn new(domain: &Domain, position: &[Vec3], cell_size_m: f64, team: &Team) -> Self {
         let length = domain.length_m();
         let mut dims = [1usize; 3];
         for axis in 0..3 {
@@ -214,7 +210,8 @@ impl NeighborList {
     }
 
     /// True when some particle has moved more than `allowance_m` from where it was at the build, or a moving
-    /// wall's surface has. [`NeighborList::refilter`] asks it of the list it filters.
+    /// wall's surface has. [`NeighborList::refilter`] asks it of the list it filters. The particles are scanned in
+    /// chunks on `team`.
     pub fn displaced_beyond(
         &self,
         domain: &Domain,
@@ -222,23 +219,27 @@ impl NeighborList {
         walls: &[Wall],
         wall_angle: &[f64],
         allowance_m: f64,
+        team: &Team,
     ) -> bool {
         if self.reference_position.len() != position.len() || self.builds == 0 {
             return true;
         }
         let limit2 = allowance_m * allowance_m;
-        position
-            .iter()
-            .zip(&self.reference_position)
-            .any(|(x, x0)| domain.separation(x, x0).norm_squared() > limit2)
+        let moved = |particles: std::ops::Range<usize>| {
+            position[particles.clone()]
+                .iter()
+                .zip(&self.reference_position[particles])
+                .any(|(x, x0)| domain.separation(x, x0).norm_squared() > limit2)
+        };
+        team.map_chunks(position.len(), BUILD_CHUNK, moved).contains(&true)
             || walls
                 .iter()
                 .zip(wall_angle.iter().zip(&self.reference_wall_angle))
                 .any(|(w, (a, a0))| w.max_lever_m() * (a - a0).abs() > allowance_m)
     }
 
-    /// Rebuilds the lists by searching the cells for what `criteria` holds, on `team` if given.
-    pub fn build(&mut self, criteria: &Criteria, team: Option<&Team>) {
+    /// Rebuilds the lists by searching the cells for what `criteria` holds, on `team`.
+    pub fn build(&mut self, criteria: &Criteria, team: &Team) {
         let Criteria {
             domain,
             position,
@@ -277,7 +278,7 @@ impl NeighborList {
     /// list with a larger skin) instead of the cells: the two-level scheme of the force pass. Complete only while no
     /// particle has moved more than (outer skin − `criteria.skin_m`)/2 since `outer` was built
     /// ([`NeighborList::displaced_beyond`]); the caller checks that first.
-    pub fn refilter(&mut self, outer: &NeighborList, criteria: &Criteria, team: Option<&Team>) {
+    pub fn refilter(&mut self, outer: &NeighborList, criteria: &Criteria, team: &Team) {
         debug_assert!(criteria.skin_m <= outer.skin_m);
         self.assemble(criteria, team, |i, partners, near_walls| {
             partners.extend(
@@ -301,12 +302,12 @@ impl NeighborList {
     }
 
     /// Fills the lists from `candidates(i, partners, walls)`, which appends particle i's partners (ascending, all
-    /// greater than i) and walls (ascending), over chunks of particles (on `team` if given); records the reference
-    /// state.
+    /// greater than i) and walls (ascending), and records the reference state. Chunks of particles are searched on
+    /// `team`, and then each chunk's results are copied to their places in the lists, also on `team`.
     fn assemble(
         &mut self,
         criteria: &Criteria,
-        team: Option<&Team>,
+        team: &Team,
         candidates: impl Fn(usize, &mut Vec<u32>, &mut Vec<u16>) + Sync,
     ) {
         let n = criteria.position.len();
@@ -316,16 +317,14 @@ impl NeighborList {
             walls: Vec<u16>,
             wall_counts: Vec<u32>,
         }
-        let chunks: Vec<Chunk> = map_indices(team, n.div_ceil(BUILD_CHUNK), 1, |chunk| {
-            let lo = chunk * BUILD_CHUNK;
-            let hi = (lo + BUILD_CHUNK).min(n);
+        let chunks: Vec<Chunk> = team.map_chunks(n, BUILD_CHUNK, |particles| {
             let mut out = Chunk {
-                partners: Vec::with_capacity((hi - lo) * 8),
-                counts: Vec::with_capacity(hi - lo),
+                partners: Vec::with_capacity(particles.len() * 8),
+                counts: Vec::with_capacity(particles.len()),
                 walls: Vec::new(),
-                wall_counts: Vec::with_capacity(hi - lo),
+                wall_counts: Vec::with_capacity(particles.len()),
             };
-            for i in lo..hi {
+            for i in particles {
                 let (before, walls_before) = (out.partners.len(), out.walls.len());
                 candidates(i, &mut out.partners, &mut out.walls);
                 out.counts.push((out.partners.len() - before) as u32);
@@ -334,30 +333,61 @@ impl NeighborList {
             out
         });
 
-        self.start.clear();
-        self.start.reserve(n + 1);
-        self.start.push(0);
-        self.partner.clear();
-        self.wall_start.clear();
-        self.wall_start.reserve(n + 1);
-        self.wall_start.push(0);
-        self.wall_partner.clear();
-        let (mut total, mut wall_total) = (0u32, 0u32);
+        // Where each chunk's results go.
+        let particle_ends: Vec<usize> = (1..=chunks.len()).map(|c| (c * BUILD_CHUNK).min(n)).collect();
+        let (mut pair_ends, mut wall_ends) = (Vec::with_capacity(chunks.len()), Vec::with_capacity(chunks.len()));
+        let (mut total, mut wall_total) = (0usize, 0usize);
         for chunk in &chunks {
-            for c in &chunk.counts {
-                total += c;
-                self.start.push(total);
+            total += chunk.partners.len();
+            wall_total += chunk.walls.len();
+            pair_ends.push(total);
+            wall_ends.push(wall_total);
+        }
+        assert!(
+            total <= u32::MAX as usize && wall_total <= u32::MAX as usize,
+            "more than 2^32 neighbour pairs"
+        );
+        self.start.resize(n + 1, 0);
+        self.start[0] = 0;
+        self.partner.resize(total, 0);
+        self.wall_start.resize(n + 1, 0);
+        self.wall_start[0] = 0;
+        self.wall_partner.resize(wall_total, 0);
+        self.reference_position.resize(n, Vec3::zeros());
+        let parts: Vec<_> = chunks
+            .into_iter()
+            .zip(split_at_ends(&mut self.start[1..], &particle_ends))
+            .zip(split_at_ends(&mut self.partner, &pair_ends))
+            .zip(split_at_ends(&mut self.wall_start[1..], &particle_ends))
+            .zip(split_at_ends(&mut self.wall_partner, &wall_ends))
+            .zip(split_at_ends(&mut self.reference_position, &particle_ends))
+            .collect();
+        let place = |c: usize, (((((chunk, start), partner), wall_start), wall_partner), reference): Placed| {
+            let lo = c * BUILD_CHUNK;
+            let mut end = if c == 0 { 0 } else { pair_ends[c - 1] as u32 };
+            for (s, count) in start.iter_mut().zip(&chunk.counts) {
+                end += count;
+                *s = end;
             }
-            self.partner.extend_from_slice(&chunk.partners);
-            for c in &chunk.wall_counts {
-                wall_total += c;
-                self.wall_start.push(wall_total);
+            let mut end = if c == 0 { 0 } else { wall_ends[c - 1] as u32 };
+            for (s, count) in wall_start.iter_mut().zip(&chunk.wall_counts) {
+                end += count;
+                *s = end;
             }
-            self.wall_partner.extend_from_slice(&chunk.walls);
+            partner.copy_from_slice(&chunk.partners);
+            wall_partner.copy_from_slice(&chunk.walls);
+            reference.copy_from_slice(&criteria.position[lo..lo + reference.len()]);
+        };
+        type Placed<'a> = (
+            ((((Chunk, &'a mut [u32]), &'a mut [u32]), &'a mut [u32]), &'a mut [u16]),
+            &'a mut [Vec3],
+        );
+        if team.size() > 1 && parts.len() > 1 {
+            team.map_parts(parts, place);
+        } else {
+            parts.into_iter().enumerate().for_each(|(c, part)| place(c, part));
         }
 
-        self.reference_position.clear();
-        self.reference_position.extend_from_slice(criteria.position);
         self.reference_wall_angle.clear();
         self.reference_wall_angle.extend_from_slice(criteria.wall_angle);
         self.skin_m = criteria.skin_m;
@@ -429,7 +459,8 @@ mod tests {
             pseudo_2d: false,
         };
         let mut outer = NeighborList::default();
-        outer.build(&at_start, None);
+        let one = Team::new(1);
+        outer.build(&at_start, &one);
         // Everyone moves by just under (skin − inner)/2, in random directions.
         let allowance = 0.5 * (skin - inner);
         let moved: Vec<Vec3> = start
@@ -441,16 +472,16 @@ mod tests {
                 y
             })
             .collect();
-        assert!(!outer.displaced_beyond(&domain, &moved, &walls, &angles, allowance));
+        assert!(!outer.displaced_beyond(&domain, &moved, &walls, &angles, allowance, &one));
         let mut refiltered = NeighborList::default();
         let moved_inner = Criteria {
             position: &moved,
             skin_m: inner,
             ..at_start
         };
-        refiltered.refilter(&outer, &moved_inner, None);
+        refiltered.refilter(&outer, &moved_inner, &Team::new(2));
         let mut direct = NeighborList::default();
-        direct.build(&moved_inner, None);
+        direct.build(&moved_inner, &one);
         assert_eq!(refiltered.start, direct.start);
         assert_eq!(refiltered.partner, direct.partner);
         assert_eq!(refiltered.wall_start, direct.wall_start);
@@ -463,7 +494,39 @@ mod tests {
         // Moving one particle a little further is what `displaced_beyond` reports.
         let mut far = moved.clone();
         far[7] = start[7] + Vec3::new(0.0, 1.01 * allowance, 0.0);
-        assert!(outer.displaced_beyond(&domain, &far, &walls, &angles, allowance));
+        assert!(outer.displaced_beyond(&domain, &far, &walls, &angles, allowance, &one));
+    }
+
+    /// `displaced_beyond` on a team scans every chunk: a move past the allowance in the last chunk is seen.
+    #[test]
+    fn displacement_is_seen_in_any_chunk_on_a_team() {
+        let domain = Domain::new(Vec3::zeros(), Vec3::new(1.0, 1.0, 1.0), [false; 3]);
+        let n = 3 * BUILD_CHUNK + 5;
+        let mut rnd = uniform(7);
+        let position: Vec<Vec3> = (0..n).map(|_| Vec3::new(rnd(), rnd(), rnd())).collect();
+        let radius = vec![0.001; n];
+        let criteria = Criteria {
+            domain: &domain,
+            position: &position,
+            radius: &radius,
+            skin_m: 0.002,
+            range: Reach::default(),
+            walls: &[],
+            wall_angle: &[],
+            pseudo_2d: false,
+        };
+        let team = Team::new(2);
+        let mut list = NeighborList::default();
+        list.build(&criteria, &team);
+        assert!(!list.displaced_beyond(&domain, &position, &[], &[], 1e-4, &team));
+        for i in [0, BUILD_CHUNK, n - 1] {
+            let mut moved = position.clone();
+            moved[i].x += 2e-4;
+            assert!(
+                list.displaced_beyond(&domain, &moved, &[], &[], 1e-4, &team),
+                "particle {i}"
+            );
+        }
     }
 
     /// The cell-list half list equals the brute-force one, on periodic boxes with many cells per axis and with only
@@ -493,9 +556,9 @@ mod tests {
                 pseudo_2d: false,
             };
             let mut list = NeighborList::default();
-            list.build(&criteria, None);
+            list.build(&criteria, &Team::new(1));
             let mut on_team = NeighborList::default();
-            on_team.build(&criteria, Some(&Team::new(2)));
+            on_team.build(&criteria, &Team::new(2));
             assert_eq!((&on_team.start, &on_team.partner), (&list.start, &list.partner));
             for i in 0..n {
                 let mut expected = vec![];

@@ -204,7 +204,7 @@ impl Simulation {
             timers: StageTimers::default(),
         };
         let team = Arc::clone(&sim.team);
-        sim.build_lists(true, Some(&*team));
+        sim.build_lists(true, &team);
         let layout = sim.config.contact_law.history_layout();
         let (history, orphans) = AlignedHistory::from_store(&state.contacts, &sim.list, layout);
         if orphans > 0 {
@@ -373,7 +373,7 @@ impl Simulation {
                 let g0 = config.gravity.at(self.time_s);
                 let (particles, inverse, reference) =
                     (&mut self.particles, &self.inverse, self.list.reference_positions());
-                let team = Some(&*self.team);
+                let team = &*self.team;
                 kick_drift(
                     particles,
                     inverse,
@@ -398,7 +398,12 @@ impl Simulation {
             &config.walls,
             &self.wall_angle_rad,
         ) {
-            if let Some(i) = find_lost(&self.particles, &config.domain, self.particles.max_radius_m()) {
+            if let Some(i) = find_lost(
+                &self.particles.position_m,
+                &config.domain,
+                self.particles.max_radius_m(),
+                &self.team,
+            ) {
                 let position_m = self.particles.position_m[i];
                 return Err(if (position_m.x + position_m.y + position_m.z).is_finite() {
                     NumericalError::ParticleLost {
@@ -591,7 +596,7 @@ impl Simulation {
             &self.history.pair.touching,
             RangePlan::ranges_for(self.threads()),
             Some(&self.ranges),
-            Some(&*self.team),
+            &self.team,
         );
         self.steps_since_rebalance = 0;
     }
@@ -602,7 +607,7 @@ impl Simulation {
         // On the force pass's team, whose helpers are spinning from the last pass (no wake-up to pay).
         // (A one-thread team runs everything on this thread.)
         let team = Arc::clone(&self.team);
-        let team = Some(&*team);
+        let team = &*team;
         self.build_lists(self.needs_cell_search(), team);
         let layout = self.config.contact_law.history_layout();
         let (history, orphans) = self.history.remap(&old_list, &self.list, layout, team);
@@ -632,12 +637,13 @@ impl Simulation {
                 &c.walls,
                 &self.wall_angle_rad,
                 allowance_m,
+                &self.team,
             )
     }
 
     /// Brings `list` up to date with the current positions, with a cell search when `searched` (which must be
-    /// true whenever [`Simulation::needs_cell_search`] is), on `team` if given.
-    fn build_lists(&mut self, searched: bool, team: Option<&Team>) {
+    /// true whenever [`Simulation::needs_cell_search`] is), on `team`.
+    fn build_lists(&mut self, searched: bool, team: &Team) {
         let c = &self.config;
         let outer = Criteria {
             domain: &c.domain,

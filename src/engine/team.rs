@@ -164,6 +164,24 @@ impl Team {
             .collect()
     }
 
+    /// `f` over the consecutive ranges of `chunk_len` indices (the last may be shorter) that cover `0..n`, with the
+    /// results in range order: as parts of [`Team::map_parts`] when the team has several threads and there is more
+    /// than one range, else on the calling thread. Results are the same either way.
+    pub fn map_chunks<T: Send>(
+        &self,
+        n: usize,
+        chunk_len: usize,
+        f: impl Fn(std::ops::Range<usize>) -> T + Sync,
+    ) -> Vec<T> {
+        let chunk_len = chunk_len.max(1);
+        let ranges = (0..n.div_ceil(chunk_len)).map(|k| k * chunk_len..((k + 1) * chunk_len).min(n));
+        if self.size() > 1 && n > chunk_len {
+            self.map_parts(ranges.collect(), |_, range| f(range))
+        } else {
+            ranges.map(f).collect()
+        }
+    }
+
     /// Parks the helpers until the next [`Team::run`].
     pub fn rest(&self) {
         self.shared.resting.store(true, Ordering::SeqCst);
@@ -304,6 +322,19 @@ mod tests {
         for count in [0usize, 1, 2, 5, 16, 33] {
             let out = team.map_parts((0..count).map(|k| k * 10).collect(), |k, p| (k, p + 1));
             assert_eq!(out, (0..count).map(|k| (k, k * 10 + 1)).collect::<Vec<_>>());
+        }
+    }
+
+    #[test]
+    fn map_chunks_covers_every_index_once_in_order() {
+        for threads in [1, 2] {
+            let team = Team::new(threads);
+            for (n, len) in [(0usize, 4usize), (3, 4), (4, 4), (9, 4), (100, 7)] {
+                let out = team.map_chunks(n, len, |range| range);
+                let flat: Vec<usize> = out.iter().flat_map(|r| r.clone()).collect();
+                assert_eq!(flat, (0..n).collect::<Vec<_>>());
+                assert!(out.iter().all(|r| r.len() <= len && !r.is_empty()));
+            }
         }
     }
 
