@@ -302,6 +302,67 @@ fn a_young_laplace_bridge_holds_two_beads_at_its_own_balance() {
     );
 }
 
+/// The bridge's energy account: two elastic (restitution 1), wet beads with an inviscid liquid meet head-on, a
+/// bridge forms on contact and ruptures at Lian's distance (seed 000 eq 2.18), and they leave with exactly the
+/// kinetic energy they came with less the rupture work, the integral of Mikami's force (eqs 2.16–2.17) from contact
+/// to the rupture distance: the capillary force adds no energy and loses none but that work.
+#[test]
+fn a_bridge_takes_exactly_its_rupture_work_from_an_elastic_pair() {
+    use granflow::engine::models::capillary::lian_rupture_gap_m;
+    let yaml = pair(
+        "{ liquid_bridge: { surface_tension_n_per_m: 0.072, viscosity_pa_s: 0.0 } }",
+        5.0e-4,
+        ", liquid_content: 0.02",
+    )
+    .replace("restitution: 0.8", "restitution: 1.0");
+    let mut sim = two_beads(&yaml);
+    let approach = 0.12;
+    sim.particles.velocity_m_per_s[0].x = 0.5 * approach;
+    sim.particles.velocity_m_per_s[1].x = -0.5 * approach;
+    let mass = sim.particles.mass_kg[0];
+    let reduced_mass = 0.5 * mass;
+    sim.run_steps(30_000).expect("stable");
+    let s = sim.snapshot();
+    assert!(s.cohesion.pairs.is_empty(), "the bridge has ruptured");
+    assert_eq!(sim.cohesion_events.bridges_formed, 1);
+    assert_eq!(sim.cohesion_events.bridges_ruptured, 1);
+    // The bridge took the liquid on each bead's facing cap, (L/2)(1 − √(3/4)) of L = 0.02 R³ (see above).
+    let volume = 2.0 * 0.5 * 0.02e-9 * (1.0 - 0.75f64.sqrt());
+    let rupture_gap = lian_rupture_gap_m(volume, 0.0, 0.0);
+    let r_star = 0.0005;
+    // Simpson's rule over [0, rupture gap].
+    let intervals = 20_000;
+    let h = rupture_gap / intervals as f64;
+    let work: f64 = (0..=intervals)
+        .map(|k| {
+            let weight = if k == 0 || k == intervals {
+                1.0
+            } else if k % 2 == 1 {
+                4.0
+            } else {
+                2.0
+            };
+            weight * mikami_force_n(r_star, volume, k as f64 * h, 0.0, 0.072)
+        })
+        .sum::<f64>()
+        * h
+        / 3.0;
+    let speed = s.particles.velocity_m_per_s[1].x - s.particles.velocity_m_per_s[0].x;
+    let lost = 0.5 * reduced_mass * (approach * approach - speed * speed);
+    println!(
+        "bridge of {volume:e} m³, rupture gap {rupture_gap:e} m, rupture work {work:e} J; the pair lost {lost:e} J \
+         (came at {approach} m/s, leaves at {speed:e} m/s)"
+    );
+    assert!(
+        work > 0.1 * 0.5 * reduced_mass * approach * approach,
+        "the work must be a sizeable part of the energy"
+    );
+    assert!(
+        (lost / work - 1.0).abs() < 0.01,
+        "lost {lost:e} J against the rupture work {work:e} J"
+    );
+}
+
 /// Square well as crossing impulses (seed 001 §6.2.4.2): a head-on pair approaching at relative speed a₀ gains
 /// 2D/μ of squared speed entering the well, collides with restitution e and escapes with √(e²(a₀² + 2D/μ) − 2D/μ)
 /// if that is real; otherwise it is captured and stays in the well.
