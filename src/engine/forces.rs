@@ -717,6 +717,8 @@ impl RangePlan {
     /// to the other threads (see `Team::map_parts`), at the price of more pairs crossing a range boundary. Measured
     /// on the benchmark column with 2 threads (`granflow bench dem --threads 2 --speedup`, 2026-12-01): 2 per thread
     /// gave speed-ups of 1.79-1.82, 4 gave 1.78-1.80 (and 1.69-1.73 at 8,000 steps), 8 gave 1.68, 16 gave 1.55-1.58.
+    /// On 2026-12-03, two two-thread simulations interleaved in one process (a probe): 3 per thread took 0.998 and 4
+    /// took 1.020 times as long as 2 (the same code against itself: 1.003).
     pub const PER_THREAD: usize = 2;
 
     /// How many ranges `threads` threads work on (one range, the serial pass, on one thread).
