@@ -3,11 +3,13 @@
 
     python3 scripts/d4-trajectory-probe.py --out results/d4-trajectory-probe > REPORT.md
 
-Builds 18 scenarios from campaigns/validation/d4-mixing-vs-cag.yaml at 2.0 m/s (dry, gamma = 0.02 and 0.08 N/m;
-replicate seeds 1-3), each once as the campaign has it (400 equal beads on a jittered lattice) and once with five
-radii (0.95-1.00 x 1.35 mm, drawn per bead, same lattice and jitter) to break the lattice's order. Each runs with
+Builds up to 18 scenarios from campaigns/validation/d4-mixing-vs-cag.yaml at 2.0 m/s: dry, gamma = 0.02 and
+0.08 N/m, replicate seeds 1-3, wet beads carrying --liquid-content V/R^3 of liquid (default 0.01, D4's); each as the
+campaign has it (400 equal beads on a jittered lattice; --beds mono) and with five radii (0.95-1.00 x 1.35 mm, drawn
+per bead, same lattice and jitter, to break the lattice's order; --beds poly), or both (default). Each runs with
 `granflow simulate`, two at a time, with a checkpoint every 1600 steps (0.02 s) kept, so that every bead can be
-followed. A finished run is not rerun. Prints Markdown; writes frames.png (needs matplotlib) into --out.
+followed. A finished run is not rerun. Prints Markdown; writes frames.png (needs matplotlib; seed 1 of the equal
+beads) into --out.
 
 Needs numpy, h5py and PyYAML. The measures do not use the campaign's kNN neighbourhoods:
 - colour = which half a bead started in; f(t) = fraction of the left-starting beads in the right half, after
@@ -37,7 +39,7 @@ import yaml
 CAMPAIGN = "campaigns/validation/d4-mixing-vs-cag.yaml"
 U_M_PER_S = 2.0
 SEEDS = (1, 2, 3)
-LIQUIDS = (("dry", 0.0, 0.01), ("wet-0.02", 0.01, 0.02), ("wet-0.08", 0.01, 0.08))
+TENSIONS = (0.02, 0.08)
 RADIUS_FACTORS = (0.95, 0.9625, 0.975, 0.9875, 1.0)
 CHECKPOINT_EVERY_STEPS = 1600
 
@@ -143,6 +145,8 @@ def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--out", default="results/d4-trajectory-probe")
     ap.add_argument("--granflow", default="target/release/granflow")
+    ap.add_argument("--liquid-content", type=float, default=0.01, help="V/R^3 of liquid per wet bead (D4: 0.01)")
+    ap.add_argument("--beds", choices=["mono", "poly", "both"], default="both")
     args = ap.parse_args()
     # PyYAML reads YAML 1.1, where 1.0e7 (no sign after the e) is a string; the campaign is YAML 1.2.
     loader = yaml.SafeLoader
@@ -157,8 +161,10 @@ def main():
     width_m = base["domain"]["hi_m"][0] - base["domain"]["lo_m"][0]
     os.makedirs(args.out, exist_ok=True)
     jobs = []
-    for poly in (False, True):
-        for label, liquid, gamma in LIQUIDS:
+    liquids = [("dry", 0.0, 0.01)] + [(f"wet-{g}", args.liquid_content, g) for g in TENSIONS]
+    beds = {"mono": (False,), "poly": (True,), "both": (False, True)}[args.beds]
+    for poly in beds:
+        for label, liquid, gamma in liquids:
             for seed in SEEDS:
                 name = f"{'poly' if poly else 'mono'}-{label}-s{seed}"
                 path = os.path.join(args.out, name + ".json")
@@ -175,7 +181,8 @@ def main():
         list(pool.map(run, jobs))
 
     print("# D4 trajectory probe: dry and wet beds followed bead by bead (2.0 m/s)\n")
-    print(f"Command: `python3 scripts/d4-trajectory-probe.py --out {args.out}`. {__doc__.split('Needs')[1].strip()}\n")
+    print(f"Command: `python3 scripts/d4-trajectory-probe.py --out {args.out} --liquid-content {args.liquid_content} "
+          f"--beds {args.beds}`. Wet beads carry V/R³ = {args.liquid_content} of liquid. {__doc__.split('PyYAML. ')[1].strip()}\n")
     print("| bed | liquid | seed | k_half (1/s) | f at 1.5 / 2 / 3 / 5 s | MSD_x(1 s) (mm²) | mean height (mm) | "
           "rms v_y (m/s) |")
     print("|---|---|---|---|---|---|---|---|")
@@ -196,7 +203,7 @@ def main():
         print(f"| {bed} | {label} | {k:.2f} | {k / k_dry:.2f} | {np.mean([m['msd_x_mm2'] for m in ms]):.1f} | "
               f"{np.mean([m['mean_height_mm'] for m in ms]):.1f} | {np.mean([m['vy_rms'] for m in ms]):.3f} |")
     shown = [(n.replace("mono-", "").replace("-s1", ""), d) for n, _, d in jobs if n.startswith("mono") and n.endswith("s1")]
-    if frames(shown, os.path.join(args.out, "frames.png"), [0.9, 1.1, 1.2, 1.3, 1.5, 2.0, 3.0, 4.0, 5.0]):
+    if shown and frames(shown, os.path.join(args.out, "frames.png"), [0.9, 1.1, 1.2, 1.3, 1.5, 2.0, 3.0, 4.0, 5.0]):
         print(f"\nframes.png: seed 1 of each liquid (mono), beads coloured by the half they started in.")
 
 
