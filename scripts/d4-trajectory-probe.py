@@ -44,14 +44,20 @@ RADIUS_FACTORS = (0.95, 0.9625, 0.975, 0.9875, 1.0)
 CHECKPOINT_EVERY_STEPS = 1600
 
 
-def scenario(base, name, seed, liquid, gamma, poly):
+def scenario(base, name, seed, liquid, gamma, poly, youngs_modulus_pa):
     s = copy.deepcopy(base)
+    # A stiffer bead has a shorter contact time, so a shorter DEM step (dt is a fraction of it, t_c ~ E^(-2/5));
+    # the gas step and the checkpoint interval keep their lengths in seconds.
+    steps_scale = (youngs_modulus_pa / base["species"][0]["youngs_modulus_pa"]) ** 0.4
+    for sp in s["species"]:
+        sp["youngs_modulus_pa"] = youngs_modulus_pa
+    s["gas"]["dem_steps_per_gas_step"] = round(base["gas"]["dem_steps_per_gas_step"] * steps_scale)
     s["name"] = name
     s["seed"] = seed
     s["gas"]["sides"]["y_low"]["inlet"]["superficial_velocity_m_per_s"] = U_M_PER_S
     s["cohesion"]["liquid_bridge"]["surface_tension_n_per_m"] = gamma
     s.setdefault("output", {})
-    s["output"]["checkpoint_every_steps"] = CHECKPOINT_EVERY_STEPS
+    s["output"]["checkpoint_every_steps"] = round(CHECKPOINT_EVERY_STEPS * steps_scale)
     s["output"]["keep_checkpoints"] = 400
     for sp in s["species"]:
         sp["liquid_content"] = liquid
@@ -147,6 +153,7 @@ def main():
     ap.add_argument("--granflow", default="target/release/granflow")
     ap.add_argument("--liquid-content", type=float, default=0.01, help="V/R^3 of liquid per wet bead (D4: 0.01)")
     ap.add_argument("--beds", choices=["mono", "poly", "both"], default="both")
+    ap.add_argument("--youngs-modulus-pa", type=float, default=None, help="default: the campaign's")
     args = ap.parse_args()
     # PyYAML reads YAML 1.1, where 1.0e7 (no sign after the e) is a string; the campaign is YAML 1.2.
     loader = yaml.SafeLoader
@@ -161,6 +168,7 @@ def main():
     width_m = base["domain"]["hi_m"][0] - base["domain"]["lo_m"][0]
     os.makedirs(args.out, exist_ok=True)
     jobs = []
+    youngs_modulus_pa = args.youngs_modulus_pa or float(base["species"][0]["youngs_modulus_pa"])
     liquids = [("dry", 0.0, 0.01)] + [(f"wet-{g}", args.liquid_content, g) for g in TENSIONS]
     beds = {"mono": (False,), "poly": (True,), "both": (False, True)}[args.beds]
     for poly in beds:
@@ -169,7 +177,7 @@ def main():
                 name = f"{'poly' if poly else 'mono'}-{label}-s{seed}"
                 path = os.path.join(args.out, name + ".json")
                 with open(path, "w") as fh:
-                    json.dump(scenario(base, name, seed, liquid, gamma, poly), fh)
+                    json.dump(scenario(base, name, seed, liquid, gamma, poly, youngs_modulus_pa), fh)
                 jobs.append((name, path, os.path.join(args.out, name)))
 
     def run(job):
@@ -182,7 +190,8 @@ def main():
 
     print("# D4 trajectory probe: dry and wet beds followed bead by bead (2.0 m/s)\n")
     print(f"Command: `python3 scripts/d4-trajectory-probe.py --out {args.out} --liquid-content {args.liquid_content} "
-          f"--beds {args.beds}`. Wet beads carry V/R³ = {args.liquid_content} of liquid. {__doc__.split('PyYAML. ')[1].strip()}\n")
+          f"--beds {args.beds} --youngs-modulus-pa {youngs_modulus_pa:g}`. Wet beads carry V/R³ = {args.liquid_content} of "
+          f"liquid; E = {youngs_modulus_pa:g} Pa. {__doc__.split('PyYAML. ')[1].strip()}\n")
     print("| bed | liquid | seed | k_half (1/s) | f at 1.5 / 2 / 3 / 5 s | MSD_x(1 s) (mm²) | mean height (mm) | "
           "rms v_y (m/s) |")
     print("|---|---|---|---|---|---|---|---|")
