@@ -6,7 +6,8 @@
 Builds up to 18 scenarios from campaigns/validation/d4-mixing-vs-cag.yaml at 2.0 m/s: dry, gamma = 0.02 and
 0.08 N/m, replicate seeds 1-3, wet beads carrying --liquid-content V/R^3 of liquid (default 0.01, D4's); each as the
 campaign has it (400 equal beads on a jittered lattice; --beds mono) and with five radii (0.95-1.00 x 1.35 mm, drawn
-per bead, same lattice and jitter, to break the lattice's order; --beds poly), or both (default). Each runs with
+per bead, same lattice and jitter, to break the lattice's order; --beds poly), or both (default); --width-factor W
+makes the bed W times as wide (domain, gas cells across and lattice columns; same height). Each runs with
 `granflow simulate`, two at a time, with a checkpoint every 1600 steps (0.02 s) kept, so that every bead can be
 followed. A finished run is not rerun. Prints Markdown; writes frames.png (needs matplotlib; seed 1 of the equal
 beads) into --out.
@@ -44,8 +45,14 @@ RADIUS_FACTORS = (0.95, 0.9625, 0.975, 0.9875, 1.0)
 CHECKPOINT_EVERY_STEPS = 1600
 
 
-def scenario(base, name, seed, liquid, gamma, poly, youngs_modulus_pa):
+def scenario(base, name, seed, liquid, gamma, poly, youngs_modulus_pa, width_factor):
     s = copy.deepcopy(base)
+    # A wider bed: the domain, the gas cells across it and the lattice's columns scale; its height stays.
+    s["domain"]["hi_m"][0] = base["domain"]["hi_m"][0] * width_factor
+    s["gas"]["cells"][0] = base["gas"]["cells"][0] * width_factor
+    for fill in s["fill"]:
+        fill["lattice"]["lo_m"][0] *= width_factor
+        fill["lattice"]["hi_m"][0] *= width_factor
     # A stiffer bead has a shorter contact time, so a shorter DEM step (dt is a fraction of it, t_c ~ E^(-2/5));
     # the gas step and the checkpoint interval keep their lengths in seconds.
     steps_scale = (youngs_modulus_pa / base["species"][0]["youngs_modulus_pa"]) ** 0.4
@@ -75,7 +82,7 @@ def scenario(base, name, seed, liquid, gamma, poly, youngs_modulus_pa):
         rng = random.Random(1000 + seed)
         per = {sp["name"]: [] for sp in s["species"]}
         for iy in range(40):
-            for ix in range(10):
+            for ix in range(10 * width_factor):
                 x = 0.0015 + 0.003 * ix + rng.uniform(-1.4e-4, 1.4e-4)
                 y = 0.0015 + 0.003 * iy + rng.uniform(-1.4e-4, 1.4e-4)
                 per[f"r{rng.randrange(len(RADIUS_FACTORS))}"].append([x, y, template["radius_m"]])
@@ -120,7 +127,7 @@ def measure(run_dir, width_m):
     }
 
 
-def frames(runs, out_png, times):
+def frames(runs, out_png, times, width_m):
     try:
         import matplotlib
 
@@ -131,12 +138,12 @@ def frames(runs, out_png, times):
     fig, axes = plt.subplots(len(runs), len(times), figsize=(1.5 * len(times), 3.4 * len(runs)))
     for a, (label, run_dir) in enumerate(runs):
         t, x, _ = load(run_dir)
-        left = x[0, :, 0] < 0.015
+        left = x[0, :, 0] < width_m / 2
         for b, s in enumerate(times):
             k = int(np.argmin(abs(t - s)))
             ax = axes[a][b]
             ax.scatter(x[k, :, 0], x[k, :, 1], s=5, c=np.where(left, "tab:blue", "tab:orange"))
-            ax.set_xlim(0, 0.03)
+            ax.set_xlim(0, width_m)
             ax.set_ylim(0, 0.3)
             ax.set_aspect("equal")
             ax.set_xticks([])
@@ -153,6 +160,7 @@ def main():
     ap.add_argument("--granflow", default="target/release/granflow")
     ap.add_argument("--liquid-content", type=float, default=0.01, help="V/R^3 of liquid per wet bead (D4: 0.01)")
     ap.add_argument("--beds", choices=["mono", "poly", "both"], default="both")
+    ap.add_argument("--width-factor", type=int, default=1, help="bed width as a multiple of D4's 30 mm")
     ap.add_argument("--youngs-modulus-pa", type=float, default=None, help="default: the campaign's")
     args = ap.parse_args()
     # PyYAML reads YAML 1.1, where 1.0e7 (no sign after the e) is a string; the campaign is YAML 1.2.
@@ -165,7 +173,7 @@ def main():
     )
     campaign = yaml.load(open(CAMPAIGN), Loader=loader)
     base = campaign["base"]
-    width_m = base["domain"]["hi_m"][0] - base["domain"]["lo_m"][0]
+    width_m = (base["domain"]["hi_m"][0] - base["domain"]["lo_m"][0]) * args.width_factor
     os.makedirs(args.out, exist_ok=True)
     jobs = []
     youngs_modulus_pa = args.youngs_modulus_pa or float(base["species"][0]["youngs_modulus_pa"])
@@ -177,7 +185,7 @@ def main():
                 name = f"{'poly' if poly else 'mono'}-{label}-s{seed}"
                 path = os.path.join(args.out, name + ".json")
                 with open(path, "w") as fh:
-                    json.dump(scenario(base, name, seed, liquid, gamma, poly, youngs_modulus_pa), fh)
+                    json.dump(scenario(base, name, seed, liquid, gamma, poly, youngs_modulus_pa, args.width_factor), fh)
                 jobs.append((name, path, os.path.join(args.out, name)))
 
     def run(job):
@@ -190,7 +198,7 @@ def main():
 
     print("# D4 trajectory probe: dry and wet beds followed bead by bead (2.0 m/s)\n")
     print(f"Command: `python3 scripts/d4-trajectory-probe.py --out {args.out} --liquid-content {args.liquid_content} "
-          f"--beds {args.beds} --youngs-modulus-pa {youngs_modulus_pa:g}`. Wet beads carry V/R³ = {args.liquid_content} of "
+          f"--beds {args.beds} --youngs-modulus-pa {youngs_modulus_pa:g} --width-factor {args.width_factor}`. Wet beads carry V/R³ = {args.liquid_content} of "
           f"liquid; E = {youngs_modulus_pa:g} Pa. {__doc__.split('PyYAML. ')[1].strip()}\n")
     print("| bed | liquid | seed | k_half (1/s) | f at 1.5 / 2 / 3 / 5 s | MSD_x(1 s) (mm²) | mean height (mm) | "
           "rms v_y (m/s) |")
@@ -212,7 +220,7 @@ def main():
         print(f"| {bed} | {label} | {k:.2f} | {k / k_dry:.2f} | {np.mean([m['msd_x_mm2'] for m in ms]):.1f} | "
               f"{np.mean([m['mean_height_mm'] for m in ms]):.1f} | {np.mean([m['vy_rms'] for m in ms]):.3f} |")
     shown = [(n.replace("mono-", "").replace("-s1", ""), d) for n, _, d in jobs if n.startswith("mono") and n.endswith("s1")]
-    if shown and frames(shown, os.path.join(args.out, "frames.png"), [0.9, 1.1, 1.2, 1.3, 1.5, 2.0, 3.0, 4.0, 5.0]):
+    if shown and frames(shown, os.path.join(args.out, "frames.png"), [0.9, 1.1, 1.2, 1.3, 1.5, 2.0, 3.0, 4.0, 5.0], width_m):
         print(f"\nframes.png: seed 1 of each liquid (mono), beads coloured by the half they started in.")
 
 
