@@ -3,8 +3,8 @@
 
     python3 scripts/d4-trajectory-probe.py --out results/d4-trajectory-probe > REPORT.md
 
-Builds up to 18 scenarios from campaigns/validation/d4-mixing-vs-cag.yaml at 2.0 m/s: dry, gamma = 0.02 and
-0.08 N/m, replicate seeds 1-3, wet beads carrying --liquid-content V/R^3 of liquid (default 0.01, D4's); each as the
+Builds up to 18 scenarios from campaigns/validation/d4-mixing-vs-cag.yaml at --velocity (default 2.0 m/s): dry and
+--tensions (default gamma = 0.02 and 0.08 N/m), replicate seeds 1-3, wet beads carrying --liquid-content V/R^3 of liquid (default 0.01, D4's); each as the
 campaign has it (400 equal beads on a jittered lattice; --beds mono) and with five radii (0.95-1.00 x 1.35 mm, drawn
 per bead, same lattice and jitter, to break the lattice's order; --beds poly), or both (default); --width-factor W
 makes the bed W times as wide (domain, gas cells across and lattice columns; same height). Each runs with
@@ -38,14 +38,12 @@ import numpy as np
 import yaml
 
 CAMPAIGN = "campaigns/validation/d4-mixing-vs-cag.yaml"
-U_M_PER_S = 2.0
 SEEDS = (1, 2, 3)
-TENSIONS = (0.02, 0.08)
 RADIUS_FACTORS = (0.95, 0.9625, 0.975, 0.9875, 1.0)
 CHECKPOINT_EVERY_STEPS = 1600
 
 
-def scenario(base, name, seed, liquid, gamma, poly, youngs_modulus_pa, width_factor):
+def scenario(base, name, seed, liquid, gamma, poly, youngs_modulus_pa, width_factor, u_m_per_s):
     s = copy.deepcopy(base)
     # A wider bed: the domain, the gas cells across it and the lattice's columns scale; its height stays.
     s["domain"]["hi_m"][0] = base["domain"]["hi_m"][0] * width_factor
@@ -61,7 +59,7 @@ def scenario(base, name, seed, liquid, gamma, poly, youngs_modulus_pa, width_fac
     s["gas"]["dem_steps_per_gas_step"] = round(base["gas"]["dem_steps_per_gas_step"] * steps_scale)
     s["name"] = name
     s["seed"] = seed
-    s["gas"]["sides"]["y_low"]["inlet"]["superficial_velocity_m_per_s"] = U_M_PER_S
+    s["gas"]["sides"]["y_low"]["inlet"]["superficial_velocity_m_per_s"] = u_m_per_s
     s["cohesion"]["liquid_bridge"]["surface_tension_n_per_m"] = gamma
     s.setdefault("output", {})
     s["output"]["checkpoint_every_steps"] = round(CHECKPOINT_EVERY_STEPS * steps_scale)
@@ -162,6 +160,8 @@ def main():
     ap.add_argument("--beds", choices=["mono", "poly", "both"], default="both")
     ap.add_argument("--width-factor", type=int, default=1, help="bed width as a multiple of D4's 30 mm")
     ap.add_argument("--youngs-modulus-pa", type=float, default=None, help="default: the campaign's")
+    ap.add_argument("--velocity", type=float, default=2.0, help="superficial gas velocity, m/s")
+    ap.add_argument("--tensions", type=float, nargs="+", default=[0.02, 0.08], help="surface tensions of the wet beds, N/m")
     args = ap.parse_args()
     # PyYAML reads YAML 1.1, where 1.0e7 (no sign after the e) is a string; the campaign is YAML 1.2.
     loader = yaml.SafeLoader
@@ -177,7 +177,7 @@ def main():
     os.makedirs(args.out, exist_ok=True)
     jobs = []
     youngs_modulus_pa = args.youngs_modulus_pa or float(base["species"][0]["youngs_modulus_pa"])
-    liquids = [("dry", 0.0, 0.01)] + [(f"wet-{g}", args.liquid_content, g) for g in TENSIONS]
+    liquids = [("dry", 0.0, 0.01)] + [(f"wet-{g}", args.liquid_content, g) for g in args.tensions]
     beds = {"mono": (False,), "poly": (True,), "both": (False, True)}[args.beds]
     for poly in beds:
         for label, liquid, gamma in liquids:
@@ -185,7 +185,8 @@ def main():
                 name = f"{'poly' if poly else 'mono'}-{label}-s{seed}"
                 path = os.path.join(args.out, name + ".json")
                 with open(path, "w") as fh:
-                    json.dump(scenario(base, name, seed, liquid, gamma, poly, youngs_modulus_pa, args.width_factor), fh)
+                    json.dump(scenario(base, name, seed, liquid, gamma, poly, youngs_modulus_pa, args.width_factor,
+                                        args.velocity), fh)
                 jobs.append((name, path, os.path.join(args.out, name)))
 
     def run(job):
@@ -196,9 +197,10 @@ def main():
     with ThreadPoolExecutor(2) as pool:
         list(pool.map(run, jobs))
 
-    print("# D4 trajectory probe: dry and wet beds followed bead by bead (2.0 m/s)\n")
+    print(f"# D4 trajectory probe: dry and wet beds followed bead by bead ({args.velocity:g} m/s)\n")
     print(f"Command: `python3 scripts/d4-trajectory-probe.py --out {args.out} --liquid-content {args.liquid_content} "
-          f"--beds {args.beds} --youngs-modulus-pa {youngs_modulus_pa:g} --width-factor {args.width_factor}`. Wet beads carry V/R³ = {args.liquid_content} of "
+          f"--beds {args.beds} --youngs-modulus-pa {youngs_modulus_pa:g} --width-factor {args.width_factor} "
+          f"--velocity {args.velocity:g} --tensions {' '.join(f'{g:g}' for g in args.tensions)}`. Wet beads carry V/R³ = {args.liquid_content} of "
           f"liquid; E = {youngs_modulus_pa:g} Pa. {__doc__.split('PyYAML. ')[1].strip()}\n")
     print("| bed | liquid | seed | k_half (1/s) | f at 1.5 / 2 / 3 / 5 s | MSD_x(1 s) (mm²) | mean height (mm) | "
           "rms v_y (m/s) |")
