@@ -1,0 +1,112 @@
+#!/usr/bin/env python3
+"""How loose D3's lattice settles without gas, against the beads' stiffness.
+
+    python3 scripts/settle-porosity-probe.py --out results/settle-porosity-probe > REPORT.md
+
+Builds scenarios from campaigns/validation/d3-wet-umf.yaml with the gas and the liquid removed: the lattice of 400
+beads (3.0 mm apart) falls and settles for 0.8 s. For each Young's modulus (default 1e7, 1e9 and 6.9e10 Pa, the
+last the seed's glass) it runs the unjittered lattice (seed 1) and the jittered one (D3's 0.14 mm, seeds 1-3), with
+`granflow simulate`, two at a time; a finished run is not rerun. It prints the final mean bead height and bed top
+and the porosity of the settled bed, ε = 1 - (2/3) φ₂, where φ₂ = N π R² / (W H) is the area fraction of the bed
+(H = 2 x the mean centre height) and 2/3 the volume share of a sphere in the slab one diameter deep.
+
+Needs PyYAML.
+"""
+
+import argparse
+import copy
+import json
+import math
+import os
+import re
+import subprocess
+import sys
+from concurrent.futures import ThreadPoolExecutor
+
+import yaml
+
+CAMPAIGN = "campaigns/validation/d3-wet-umf.yaml"
+END_TIME_S = 0.8
+
+
+def yaml_loader():
+    # PyYAML reads YAML 1.1, where 1.0e7 (no sign after the e) is a string; the campaign is YAML 1.2.
+    loader = yaml.SafeLoader
+    loader.add_implicit_resolver(
+        "tag:yaml.org,2002:float",
+        re.compile(r"^[-+]?(?:[0-9][0-9_]*\.[0-9_]*(?:[eE][-+]?[0-9]+)?|\.[0-9_]+(?:[eE][-+]?[0-9]+)?"
+                   r"|[0-9][0-9_]*[eE][-+]?[0-9]+|[-+]?\.(?:inf|Inf|INF)|\.(?:nan|NaN|NAN))$"),
+        list("-+0123456789."),
+    )
+    return loader
+
+
+def main():
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--out", default="results/settle-porosity-probe")
+    ap.add_argument("--granflow", default="target/release/granflow")
+    ap.add_argument("--youngs-moduli-pa", type=float, nargs="+", default=[1e7, 1e9, 6.9e10])
+    args = ap.parse_args()
+    base = yaml.load(open(CAMPAIGN), Loader=yaml_loader())["base"]
+    base.pop("gas")
+    base.pop("cohesion")
+    base["time"]["end_time_s"] = END_TIME_S
+    base["output"] = {"checkpoint_every_steps": 10**9, "keep_checkpoints": 1, "series_every_steps": 1000}
+    jitter_m = base["fill"][0]["lattice"]["jitter_m"]
+    os.makedirs(args.out, exist_ok=True)
+    jobs = []
+    for modulus in args.youngs_moduli_pa:
+        for jitter, seeds in ((0.0, (1,)), (jitter_m, (1, 2, 3))):
+            for seed in seeds:
+                s = copy.deepcopy(base)
+                for sp in s["species"]:
+                    sp["youngs_modulus_pa"] = modulus
+                    sp["liquid_content"] = 0.0
+                for fill in s["fill"]:
+                    fill["lattice"]["jitter_m"] = jitter
+                s["seed"] = seed
+                s["name"] = f"E{modulus:g}-jitter{jitter:g}-s{seed}"
+                path = os.path.join(args.out, s["name"] + ".json")
+                with open(path, "w") as fh:
+                    json.dump(s, fh)
+                jobs.append((modulus, jitter, seed, path, os.path.join(args.out, s["name"])))
+
+    def run(job):
+        *_, path, run_dir = job
+        out = subprocess.run([args.granflow, "simulate", path, "--out", run_dir, "--quiet"], check=True,
+                             capture_output=True, text=True).stdout
+        return json.loads(out[out.index("{"):])
+
+    with ThreadPoolExecutor(2) as pool:
+        summaries = list(pool.map(run, jobs))
+
+    species = base["species"][0]
+    radius_m = species["radius_m"]
+    width_m = base["domain"]["hi_m"][0] - base["domain"]["lo_m"][0]
+    depth_m = base["domain"]["hi_m"][2] - base["domain"]["lo_m"][2]
+    print("# Settled porosity of D3's lattice against the beads' stiffness (no gas)\n")
+    print(f"Command: `python3 scripts/settle-porosity-probe.py --out {args.out} --youngs-moduli-pa "
+          f"{' '.join(f'{m:g}' for m in args.youngs_moduli_pa)}`. Each run is `granflow simulate` of D3's lattice without gas or liquid for {END_TIME_S} s; {__doc__.split('two at a time; ')[1].split('Needs')[0].strip()}\n")
+    print("| E (Pa) | lattice | seed | mean height (mm) | bed top (mm) | ε | wall time (s) |")
+    print("|---|---|---|---|---|---|---|")
+    by_kind = {}
+    for (modulus, jitter, seed, _, _), summary in zip(jobs, summaries):
+        n = summary["particles"]
+        height_m = 2.0 * summary["mean_height_m"]
+        phi_2d = n * math.pi * radius_m**2 / (width_m * height_m)
+        eps = 1.0 - 2.0 / 3.0 * phi_2d * (2.0 * radius_m / depth_m)
+        by_kind.setdefault((modulus, jitter), []).append(eps)
+        kind = "jittered" if jitter > 0 else "exact"
+        print(f"| {modulus:g} | {kind} | {seed} | {summary['mean_height_m'] * 1e3:.2f} | {summary['bed_top_m'] * 1e3:.2f} "
+              f"| {eps:.3f} | {summary['wall_time_s']:.0f} |")
+    print("\n| E (Pa) | exact lattice ε | jittered ε, mean of 3 |")
+    print("|---|---|---|")
+    for modulus in args.youngs_moduli_pa:
+        exact = by_kind[(modulus, 0.0)][0]
+        jittered = sum(by_kind[(modulus, jitter_m)]) / 3.0
+        print(f"| {modulus:g} | {exact:.3f} | {jittered:.3f} |")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
