@@ -23,6 +23,8 @@ No other dependency than the Python standard library.
 import math
 import sys
 
+from reportlib import job_rows
+
 REPORT = "results/validation/d2-dry-umf/REPORT.md"
 GAS_DENSITY_KG_PER_M3 = 1.23
 GAS_VISCOSITY_PA_S = 1.8e-5
@@ -53,19 +55,6 @@ def solve_porosity(ratio, u_m_per_s, radius_m, mass_kg):
         mid = 0.5 * (lo + hi)
         lo, hi = (mid, hi) if f(mid) > 0.0 else (lo, mid)
     return 0.5 * (lo + hi)
-
-
-def job_rows(path):
-    header, rows = None, []
-    for line in open(path, encoding="utf-8"):
-        cells = [c.strip() for c in line.strip().strip("|").split("|")]
-        if line.startswith("| status"):
-            header = cells
-        elif line.startswith("| done") and header:
-            rows.append(dict(zip(header, cells)))
-    if not rows:
-        raise SystemExit(f"{path}: no finished jobs in its job table")
-    return rows
 
 
 def measured_umf(path):

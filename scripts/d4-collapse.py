@@ -16,6 +16,8 @@ import os
 import statistics
 import sys
 
+from reportlib import job_rows
+
 REPORTS = (
     "results/validation/d4-mixing-vs-cag/REPORT.md",
     "results/validation/d4-near-umf-probe/REPORT.md",
@@ -23,20 +25,6 @@ REPORTS = (
 TENSIONS = (0.01, 0.02, 0.04, 0.08)
 # Our dry u_mf: the mean over D3's eight packings (results/validation/d3-wet-umf/REPORT.md).
 DRY_U_MF_M_PER_S = 1.4875
-
-
-def job_rows(path):
-    """The report's job table as dicts, column header to cell."""
-    header, rows = None, []
-    for line in open(path, encoding="utf-8"):
-        cells = [c.strip() for c in line.strip().strip("|").split("|")]
-        if line.startswith("| status"):
-            header = cells
-        elif line.startswith("| done") and header:
-            rows.append(dict(zip(header, cells)))
-    if not rows:
-        raise SystemExit(f"{path}: no finished jobs in its job table")
-    return rows
 
 
 def main():

@@ -27,7 +27,6 @@ import copy
 import json
 import os
 import random
-import re
 import subprocess
 import sys
 from concurrent.futures import ThreadPoolExecutor
@@ -35,7 +34,8 @@ from glob import glob
 
 import h5py
 import numpy as np
-import yaml
+
+from reportlib import load_campaign
 
 CAMPAIGN = "campaigns/validation/d4-mixing-vs-cag.yaml"
 SEEDS = (1, 2, 3)
@@ -163,15 +163,7 @@ def main():
     ap.add_argument("--velocity", type=float, default=2.0, help="superficial gas velocity, m/s")
     ap.add_argument("--tensions", type=float, nargs="+", default=[0.02, 0.08], help="surface tensions of the wet beds, N/m")
     args = ap.parse_args()
-    # PyYAML reads YAML 1.1, where 1.0e7 (no sign after the e) is a string; the campaign is YAML 1.2.
-    loader = yaml.SafeLoader
-    loader.add_implicit_resolver(
-        "tag:yaml.org,2002:float",
-        re.compile(r"^[-+]?(?:[0-9][0-9_]*\.[0-9_]*(?:[eE][-+]?[0-9]+)?|\.[0-9_]+(?:[eE][-+]?[0-9]+)?"
-                   r"|[0-9][0-9_]*[eE][-+]?[0-9]+|[-+]?\.(?:inf|Inf|INF)|\.(?:nan|NaN|NAN))$"),
-        list("-+0123456789."),
-    )
-    campaign = yaml.load(open(CAMPAIGN), Loader=loader)
+    campaign = load_campaign(CAMPAIGN)
     base = campaign["base"]
     width_m = (base["domain"]["hi_m"][0] - base["domain"]["lo_m"][0]) * args.width_factor
     os.makedirs(args.out, exist_ok=True)

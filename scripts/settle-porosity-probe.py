@@ -18,27 +18,14 @@ import copy
 import json
 import math
 import os
-import re
 import subprocess
 import sys
 from concurrent.futures import ThreadPoolExecutor
 
-import yaml
+from reportlib import load_campaign
 
 CAMPAIGN = "campaigns/validation/d3-wet-umf.yaml"
 END_TIME_S = 0.8
-
-
-def yaml_loader():
-    # PyYAML reads YAML 1.1, where 1.0e7 (no sign after the e) is a string; the campaign is YAML 1.2.
-    loader = yaml.SafeLoader
-    loader.add_implicit_resolver(
-        "tag:yaml.org,2002:float",
-        re.compile(r"^[-+]?(?:[0-9][0-9_]*\.[0-9_]*(?:[eE][-+]?[0-9]+)?|\.[0-9_]+(?:[eE][-+]?[0-9]+)?"
-                   r"|[0-9][0-9_]*[eE][-+]?[0-9]+|[-+]?\.(?:inf|Inf|INF)|\.(?:nan|NaN|NAN))$"),
-        list("-+0123456789."),
-    )
-    return loader
 
 
 def main():
@@ -47,7 +34,7 @@ def main():
     ap.add_argument("--granflow", default="target/release/granflow")
     ap.add_argument("--youngs-moduli-pa", type=float, nargs="+", default=[1e7, 1e9, 6.9e10])
     args = ap.parse_args()
-    base = yaml.load(open(CAMPAIGN), Loader=yaml_loader())["base"]
+    base = load_campaign(CAMPAIGN)["base"]
     base.pop("gas")
     base.pop("cohesion")
     base["time"]["end_time_s"] = END_TIME_S

@@ -1,0 +1,36 @@
+"""Helpers shared by the probe scripts: reading a `granflow report` job table and the campaign YAML."""
+
+import re
+
+import yaml
+
+
+def job_rows(path):
+    """The finished jobs of a report's job table, each a dict from column header to cell text."""
+    header, rows = None, []
+    for line in open(path, encoding="utf-8"):
+        cells = [c.strip() for c in line.strip().strip("|").split("|")]
+        if line.startswith("| status"):
+            header = cells
+        elif line.startswith("| done") and header:
+            rows.append(dict(zip(header, cells)))
+    if not rows:
+        raise SystemExit(f"{path}: no finished jobs in its job table")
+    return rows
+
+
+def load_campaign(path):
+    """A campaign file as plain data. PyYAML reads YAML 1.1, where 1.0e7 (no sign after the e) is a string; the
+    campaigns are YAML 1.2, so floats get the 1.2 resolver."""
+
+    class Loader(yaml.SafeLoader):
+        pass
+
+    Loader.add_implicit_resolver(
+        "tag:yaml.org,2002:float",
+        re.compile(r"^[-+]?(?:[0-9][0-9_]*\.[0-9_]*(?:[eE][-+]?[0-9]+)?|\.[0-9_]+(?:[eE][-+]?[0-9]+)?"
+                   r"|[0-9][0-9_]*[eE][-+]?[0-9]+|[-+]?\.(?:inf|Inf|INF)|\.(?:nan|NaN|NAN))$"),
+        list("-+0123456789."),
+    )
+    with open(path, encoding="utf-8") as fh:
+        return yaml.load(fh, Loader=Loader)
