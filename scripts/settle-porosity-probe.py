@@ -28,6 +28,14 @@ CAMPAIGN = "campaigns/validation/d3-wet-umf.yaml"
 END_TIME_S = 0.8
 
 
+def wall_time(summary):
+    """The run's wall time, or 'reused' for a run finished earlier (simulate then resumes at its last step and steps
+    nothing)."""
+    if summary.get("resumed_from_step") == summary["step"]:
+        return "reused"
+    return f"{summary['wall_time_s']:.0f}"
+
+
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--out", default="results/settle-porosity-probe")
@@ -85,7 +93,7 @@ def main():
         by_kind.setdefault((modulus, jitter), []).append(eps)
         kind = "jittered" if jitter > 0 else "exact"
         print(f"| {modulus:g} | {kind} | {seed} | {summary['mean_height_m'] * 1e3:.2f} | {summary['bed_top_m'] * 1e3:.2f} "
-              f"| {eps:.3f} | {summary['wall_time_s']:.0f} |")
+              f"| {eps:.3f} | {wall_time(summary)} |")
     print("\n| E (Pa) | exact lattice ε | jittered ε, mean of 3 |")
     print("|---|---|---|")
     for modulus in args.youngs_moduli_pa:
