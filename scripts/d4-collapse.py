@@ -23,8 +23,17 @@ REPORTS = (
     "results/validation/d4-near-umf-probe/REPORT.md",
 )
 TENSIONS = (0.01, 0.02, 0.04, 0.08)
-# Our dry u_mf: the mean over D3's eight packings (results/validation/d3-wet-umf/REPORT.md).
-DRY_U_MF_M_PER_S = 1.4875
+# Our dry u_mf (the mean over D3's eight packings) is read from D3's checks.
+D3_REPORT = "results/validation/d3-wet-umf/REPORT.md"
+
+
+def d3_dry_umf_m_per_s():
+    """The value of D3's check named 'dry u_mf'."""
+    for line in open(D3_REPORT, encoding="utf-8"):
+        cells = [c.strip() for c in line.strip().strip("|").split("|")]
+        if line.startswith("|") and cells[0] == "dry u_mf":
+            return float(cells[1])
+    raise SystemExit(f"{D3_REPORT}: no 'dry u_mf' check")
 
 
 def main():
@@ -42,11 +51,12 @@ def main():
                 (float(r["metric.mixing_rate_to_random_per_s [1/s]"]), float(r["metric.granular_capillary_number [1]"]))
             )
     velocities = sorted({u for u, _, _ in runs})
+    dry_umf = d3_dry_umf_m_per_s()
     print("# D4 collapse test: mixing rate constant against Ca_g at five gas velocities\n")
     print(f"Command: `python3 scripts/d4-collapse.py --out {args.out}`, from the job tables of "
           + " and ".join(f"`{p}`" for p in REPORTS) + ". "
           "k: rate constant towards a random mixture (1/s), mean over three packings; [Ca_g]; k / k(dry) at the same "
-          f"velocity. u_mf: our dry u_mf, {DRY_U_MF_M_PER_S} m/s (D3).\n")
+          f"velocity. u_mf: our dry u_mf, {dry_umf} m/s (D3).\n")
     print("| u (m/s) | u / u_mf | dry k | " + " | ".join(f"γ = {g} N/m: k [Ca_g] ratio" for g in TENSIONS) + " |")
     print("|---" * (3 + len(TENSIONS)) + "|")
     mean = {key: statistics.mean(k for k, _ in v) for key, v in runs.items()}
@@ -56,7 +66,7 @@ def main():
         for g in TENSIONS:
             k, ca = mean[(u, True, g)], runs[(u, True, g)][0][1]
             cells.append(f"{k:.3f} [{ca:.2f}] {k / dry:.2f}")
-        print(f"| {u:g} | {u / DRY_U_MF_M_PER_S:.2f} | {dry:.3f} | " + " | ".join(cells) + " |")
+        print(f"| {u:g} | {u / dry_umf:.2f} | {dry:.3f} | " + " | ".join(cells) + " |")
     slower = sorted((runs[(u, True, g)][0][1], u, g) for u in velocities for g in TENSIONS
                     if mean[(u, True, g)] < mean[(u, False, 0.0)])
     print("\nWet beds that mix slower than the dry bed at their velocity: "

@@ -27,15 +27,13 @@ import copy
 import json
 import os
 import random
-import subprocess
 import sys
-from concurrent.futures import ThreadPoolExecutor
 from glob import glob
 
 import h5py
 import numpy as np
 
-from reportlib import load_campaign
+from reportlib import load_campaign, simulate_all
 
 CAMPAIGN = "campaigns/validation/d4-mixing-vs-cag.yaml"
 SEEDS = (1, 2, 3)
@@ -181,13 +179,7 @@ def main():
                                         args.velocity), fh)
                 jobs.append((name, path, os.path.join(args.out, name)))
 
-    def run(job):
-        name, path, run_dir = job
-        subprocess.run([args.granflow, "simulate", path, "--out", run_dir, "--quiet"], check=True,
-                       stdout=subprocess.DEVNULL)
-
-    with ThreadPoolExecutor(2) as pool:
-        list(pool.map(run, jobs))
+    simulate_all(args.granflow, [(path, run_dir) for _, path, run_dir in jobs])
 
     print(f"# D4 trajectory probe: dry and wet beds followed bead by bead ({args.velocity:g} m/s)\n")
     print(f"Command: `python3 scripts/d4-trajectory-probe.py --out {args.out} --liquid-content {args.liquid_content} "

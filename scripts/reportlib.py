@@ -1,6 +1,10 @@
-"""Helpers shared by the probe scripts: reading a `granflow report` job table and the campaign YAML."""
+"""Helpers shared by the probe scripts: reading a `granflow report` job table and the campaign YAML, and running
+scenarios with `granflow simulate`."""
 
+import json
 import re
+import subprocess
+from concurrent.futures import ThreadPoolExecutor
 
 import yaml
 
@@ -34,3 +38,17 @@ def load_campaign(path):
     )
     with open(path, encoding="utf-8") as fh:
         return yaml.load(fh, Loader=Loader)
+
+
+def simulate_all(granflow, runs, parallel=2):
+    """Runs `granflow simulate SCENARIO --out DIR` for every (scenario path, run directory) of `runs`, `parallel` at
+    a time (a finished run is not rerun by simulate), and returns each run's summary, in order."""
+
+    def run(paths):
+        scenario_path, run_dir = paths
+        out = subprocess.run([granflow, "simulate", scenario_path, "--out", run_dir, "--quiet"], check=True,
+                             capture_output=True, text=True).stdout
+        return json.loads(out[out.index("{"):])
+
+    with ThreadPoolExecutor(parallel) as pool:
+        return list(pool.map(run, runs))

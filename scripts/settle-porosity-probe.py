@@ -18,11 +18,9 @@ import copy
 import json
 import math
 import os
-import subprocess
 import sys
-from concurrent.futures import ThreadPoolExecutor
 
-from reportlib import load_campaign
+from reportlib import load_campaign, simulate_all
 
 CAMPAIGN = "campaigns/validation/d3-wet-umf.yaml"
 END_TIME_S = 0.8
@@ -66,14 +64,7 @@ def main():
                     json.dump(s, fh)
                 jobs.append((modulus, jitter, seed, path, os.path.join(args.out, s["name"])))
 
-    def run(job):
-        *_, path, run_dir = job
-        out = subprocess.run([args.granflow, "simulate", path, "--out", run_dir, "--quiet"], check=True,
-                             capture_output=True, text=True).stdout
-        return json.loads(out[out.index("{"):])
-
-    with ThreadPoolExecutor(2) as pool:
-        summaries = list(pool.map(run, jobs))
+    summaries = simulate_all(args.granflow, [(path, run_dir) for *_, path, run_dir in jobs])
 
     species = base["species"][0]
     radius_m = species["radius_m"]
