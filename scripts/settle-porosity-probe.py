@@ -1,11 +1,11 @@
 #!/usr/bin/env python3
-"""How loose D3's lattice settles without gas, against the beads' stiffness.
+"""How loose D3's lattice settles without gas, against the beads' stiffness and restitution.
 
     python3 scripts/settle-porosity-probe.py --out results/settle-porosity-probe > REPORT.md
 
 Builds scenarios from campaigns/validation/d3-wet-umf.yaml with the gas and the liquid removed: the lattice of 400
 beads (3.0 mm apart) falls and settles for 0.8 s. For each Young's modulus (default 1e7, 1e9 and 6.9e10 Pa, the
-last the seed's glass) it runs the unjittered lattice (seed 1) and the jittered one (D3's 0.14 mm, seeds 1-3), with
+last the seed's glass) and each restitution coefficient (default D3's 0.9; `--restitutions`) it runs the unjittered lattice (seed 1) and the jittered one (D3's 0.14 mm, seeds 1-3), with
 `granflow simulate`, two at a time; a finished run is not rerun. It prints the final mean bead height and bed top
 and the porosity of the settled bed, ε = 1 - (2/3) φ₂, where φ₂ = N π R² / (W H) is the area fraction of the bed
 (H = 2 x the mean centre height) and 2/3 the volume share of a sphere in the slab one diameter deep.
@@ -24,6 +24,7 @@ from reportlib import load_campaign, simulate_all
 
 CAMPAIGN = "campaigns/validation/d3-wet-umf.yaml"
 END_TIME_S = 0.8
+D3_RESTITUTION = 0.9
 
 
 def wall_time(summary):
@@ -39,6 +40,7 @@ def main():
     ap.add_argument("--out", default="results/settle-porosity-probe")
     ap.add_argument("--granflow", default="target/release/granflow")
     ap.add_argument("--youngs-moduli-pa", type=float, nargs="+", default=[1e7, 1e9, 6.9e10])
+    ap.add_argument("--restitutions", type=float, nargs="+", default=[D3_RESTITUTION])
     args = ap.parse_args()
     base = load_campaign(CAMPAIGN)["base"]
     base.pop("gas")
@@ -48,7 +50,8 @@ def main():
     jitter_m = base["fill"][0]["lattice"]["jitter_m"]
     os.makedirs(args.out, exist_ok=True)
     jobs = []
-    for modulus in args.youngs_moduli_pa:
+    kinds = [(m, e) for m in args.youngs_moduli_pa for e in args.restitutions]
+    for modulus, restitution in kinds:
         for jitter, seeds in ((0.0, (1,)), (jitter_m, (1, 2, 3))):
             for seed in seeds:
                 s = copy.deepcopy(base)
@@ -57,12 +60,15 @@ def main():
                     sp["liquid_content"] = 0.0
                 for fill in s["fill"]:
                     fill["lattice"]["jitter_m"] = jitter
+                s["contact"]["normal"]["hertz"]["restitution"] = restitution
                 s["seed"] = seed
-                s["name"] = f"E{modulus:g}-jitter{jitter:g}-s{seed}"
+                # (D3's restitution keeps the names of the runs made before the option existed.)
+                e_tag = "" if restitution == D3_RESTITUTION else f"-e{restitution:g}"
+                s["name"] = f"E{modulus:g}{e_tag}-jitter{jitter:g}-s{seed}"
                 path = os.path.join(args.out, s["name"] + ".json")
                 with open(path, "w") as fh:
                     json.dump(s, fh)
-                jobs.append((modulus, jitter, seed, path, os.path.join(args.out, s["name"])))
+                jobs.append(((modulus, restitution), jitter, seed, path, os.path.join(args.out, s["name"])))
 
     summaries = simulate_all(args.granflow, [(path, run_dir) for *_, path, run_dir in jobs])
 
@@ -70,27 +76,27 @@ def main():
     radius_m = species["radius_m"]
     width_m = base["domain"]["hi_m"][0] - base["domain"]["lo_m"][0]
     depth_m = base["domain"]["hi_m"][2] - base["domain"]["lo_m"][2]
-    print("# Settled porosity of D3's lattice against the beads' stiffness (no gas)\n")
+    print("# Settled porosity of D3's lattice against the beads' stiffness and restitution (no gas)\n")
     print(f"Command: `python3 scripts/settle-porosity-probe.py --out {args.out} --youngs-moduli-pa "
-          f"{' '.join(f'{m:g}' for m in args.youngs_moduli_pa)}`. Each run is `granflow simulate` of D3's lattice without gas or liquid for {END_TIME_S} s; {__doc__.split('two at a time; ')[1].split('Needs')[0].strip()}\n")
-    print("| E (Pa) | lattice | seed | mean height (mm) | bed top (mm) | ε | wall time (s) |")
-    print("|---|---|---|---|---|---|---|")
+          f"{' '.join(f'{m:g}' for m in args.youngs_moduli_pa)} --restitutions {' '.join(f'{e:g}' for e in args.restitutions)}`. Each run is `granflow simulate` of D3's lattice without gas or liquid for {END_TIME_S} s; {__doc__.split('two at a time; ')[1].split('Needs')[0].strip()}\n")
+    print("| E (Pa) | restitution | lattice | seed | mean height (mm) | bed top (mm) | ε | wall time (s) |")
+    print("|---|---|---|---|---|---|---|---|")
     by_kind = {}
-    for (modulus, jitter, seed, _, _), summary in zip(jobs, summaries):
+    for ((modulus, restitution), jitter, seed, _, _), summary in zip(jobs, summaries):
         n = summary["particles"]
         height_m = 2.0 * summary["mean_height_m"]
         phi_2d = n * math.pi * radius_m**2 / (width_m * height_m)
         eps = 1.0 - 2.0 / 3.0 * phi_2d * (2.0 * radius_m / depth_m)
-        by_kind.setdefault((modulus, jitter), []).append(eps)
+        by_kind.setdefault((modulus, restitution, jitter), []).append(eps)
         kind = "jittered" if jitter > 0 else "exact"
-        print(f"| {modulus:g} | {kind} | {seed} | {summary['mean_height_m'] * 1e3:.2f} | {summary['bed_top_m'] * 1e3:.2f} "
+        print(f"| {modulus:g} | {restitution:g} | {kind} | {seed} | {summary['mean_height_m'] * 1e3:.2f} | {summary['bed_top_m'] * 1e3:.2f} "
               f"| {eps:.3f} | {wall_time(summary)} |")
-    print("\n| E (Pa) | exact lattice ε | jittered ε, mean of 3 |")
-    print("|---|---|---|")
-    for modulus in args.youngs_moduli_pa:
-        exact = by_kind[(modulus, 0.0)][0]
-        jittered = sum(by_kind[(modulus, jitter_m)]) / 3.0
-        print(f"| {modulus:g} | {exact:.3f} | {jittered:.3f} |")
+    print("\n| E (Pa) | restitution | exact lattice ε | jittered ε, mean of 3 |")
+    print("|---|---|---|---|")
+    for modulus, restitution in kinds:
+        exact = by_kind[(modulus, restitution, 0.0)][0]
+        jittered = sum(by_kind[(modulus, restitution, jitter_m)]) / 3.0
+        print(f"| {modulus:g} | {restitution:g} | {exact:.3f} | {jittered:.3f} |")
     return 0
 
 
