@@ -2,13 +2,15 @@
 """D4's collapse test: mixing rate constants of every D4 run against Ca_g, from the committed reports.
 
     python3 scripts/d4-collapse.py --out results/validation/d4-near-umf-probe
+    python3 scripts/d4-collapse.py --reports results/validation/d4-mixing-vs-cag-viscous/REPORT.md \
+        --out results/validation/d4-mixing-vs-cag-viscous
 
-Reads the job tables of results/validation/d4-mixing-vs-cag/REPORT.md (2.0, 2.4, 2.8 m/s) and
+By default it reads the job tables of results/validation/d4-mixing-vs-cag/REPORT.md (2.0, 2.4, 2.8 m/s) and
 results/validation/d4-near-umf-probe/REPORT.md (1.65, 1.8 m/s): the rate constant towards a random mixture
 (metric mixing_rate_to_random_per_s) and Ca_g of each job. Prints Markdown (the mean over the three packings of each
 velocity and liquid, its Ca_g and its ratio to the dry bed at the same velocity) and writes collapse.png (needs
 matplotlib): k against Ca_g, one marker per velocity, the dry beds at Ca_g = 0. Seed 000's Fig. 50 has every wet run
-on one curve that drops as Ca_g grows.
+on one curve that drops as Ca_g grows. `--reports` names other D4 reports to read instead (same job table columns).
 """
 
 import argparse
@@ -39,10 +41,11 @@ def d3_dry_umf_m_per_s():
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--out", default="results/validation/d4-near-umf-probe")
+    ap.add_argument("--reports", nargs="+", default=list(REPORTS))
     args = ap.parse_args()
     # (u, wet, γ) -> [(k, Ca_g)]; a dry job's γ only labels it.
     runs = {}
-    for path in REPORTS:
+    for path in args.reports:
         for r in job_rows(path):
             u = float(r["param.u_m_per_s"])
             wet = float(r["param.liquid_content"]) > 0.0
@@ -52,9 +55,11 @@ def main():
             )
     velocities = sorted({u for u, _, _ in runs})
     dry_umf = d3_dry_umf_m_per_s()
-    print("# D4 collapse test: mixing rate constant against Ca_g at five gas velocities\n")
-    print(f"Command: `python3 scripts/d4-collapse.py --out {args.out}`, from the job tables of "
-          + " and ".join(f"`{p}`" for p in REPORTS) + ". "
+    print(f"# D4 collapse test: mixing rate constant against Ca_g at {len(velocities)} gas velocities\n")
+    command = "python3 scripts/d4-collapse.py" + (
+        "" if args.reports == list(REPORTS) else " --reports " + " ".join(args.reports))
+    print(f"Command: `{command} --out {args.out}`, from the job tables of "
+          + " and ".join(f"`{p}`" for p in args.reports) + ". "
           "k: rate constant towards a random mixture (1/s), mean over three packings; [Ca_g]; k / k(dry) at the same "
           f"velocity. u_mf: our dry u_mf, {dry_umf} m/s (D3).\n")
     print("| u (m/s) | u / u_mf | dry k | " + " | ".join(f"γ = {g} N/m: k [Ca_g] ratio" for g in TENSIONS) + " |")
