@@ -23,7 +23,7 @@ No other dependency than the Python standard library.
 import math
 import sys
 
-from reportlib import job_rows
+from reportlib import job_rows, slab_porosity
 
 REPORT = "results/validation/d2-dry-umf/REPORT.md"
 GAS_DENSITY_KG_PER_M3 = 1.23
@@ -97,9 +97,8 @@ def main():
             packed_u.append(u)
             eps_dp.append(solve_porosity(mean_dp / weight, u, radius_m, mass_kg))
             beads = weight * WIDTH_M * depth_m / (mass_kg * G_M_PER_S2)
-            bed_height_m = 2.0 * float(j["metric.mean_height_time_avg_m [m]"])
-            phi_2d = beads * math.pi * radius_m**2 / (WIDTH_M * bed_height_m)
-            eps_h.append(1.0 - 2.0 / 3.0 * phi_2d * (2.0 * radius_m / depth_m))
+            eps_h.append(slab_porosity(beads, radius_m, WIDTH_M, depth_m,
+                                       float(j["metric.mean_height_time_avg_m [m]"])))
         ours_eps = solve_porosity(1.0, ours[(radius_mm, density)], radius_m, mass_kg)
         seed_eps = solve_porosity(1.0, SEED_UMF_M_PER_S[(radius_mm, density)], radius_m, mass_kg)
         mean = lambda v: sum(v) / len(v)

@@ -2,6 +2,7 @@
 scenarios with `granflow simulate`."""
 
 import json
+import math
 import re
 import subprocess
 from concurrent.futures import ThreadPoolExecutor
@@ -21,6 +22,14 @@ def job_rows(path):
     if not rows:
         raise SystemExit(f"{path}: no finished jobs in its job table")
     return rows
+
+
+def slab_porosity(beads, radius_m, width_m, depth_m, mean_height_m):
+    """Porosity of a pseudo-2-D bed (one layer of spheres in a slab `depth_m` deep) from its beads' mean centre
+    height: the bed is 2 x that height tall, φ₂ = N π R² / (W H) is its area fraction, and a sphere fills 2/3 of the
+    cylinder of its diameter, so ε = 1 - (2/3) φ₂ (2R / D)."""
+    phi_2d = beads * math.pi * radius_m**2 / (width_m * 2.0 * mean_height_m)
+    return 1.0 - 2.0 / 3.0 * phi_2d * (2.0 * radius_m / depth_m)
 
 
 def load_campaign(path):

@@ -20,7 +20,7 @@ import math
 import os
 import sys
 
-from reportlib import load_campaign, simulate_all
+from reportlib import load_campaign, simulate_all, slab_porosity
 
 CAMPAIGN = "campaigns/validation/d3-wet-umf.yaml"
 END_TIME_S = 0.8
@@ -83,10 +83,7 @@ def main():
     print("|---|---|---|---|---|---|---|---|")
     by_kind = {}
     for ((modulus, restitution), jitter, seed, _, _), summary in zip(jobs, summaries):
-        n = summary["particles"]
-        height_m = 2.0 * summary["mean_height_m"]
-        phi_2d = n * math.pi * radius_m**2 / (width_m * height_m)
-        eps = 1.0 - 2.0 / 3.0 * phi_2d * (2.0 * radius_m / depth_m)
+        eps = slab_porosity(summary["particles"], radius_m, width_m, depth_m, summary["mean_height_m"])
         by_kind.setdefault((modulus, restitution, jitter), []).append(eps)
         kind = "jittered" if jitter > 0 else "exact"
         print(f"| {modulus:g} | {restitution:g} | {kind} | {seed} | {summary['mean_height_m'] * 1e3:.2f} | {summary['bed_top_m'] * 1e3:.2f} "

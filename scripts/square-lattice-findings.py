@@ -29,7 +29,7 @@ import json
 import math
 import os
 
-from reportlib import load_campaign, simulate_all
+from reportlib import load_campaign, simulate_all, slab_porosity
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 spec = importlib.util.spec_from_file_location("packing", os.path.join(HERE, "d2-packing-porosity.py"))
@@ -46,8 +46,7 @@ MASS_KG = DENSITY_KG_PER_M3 * 4.0 / 3.0 * math.pi * RADIUS_M**3
 
 
 def porosity_from_mean_height(h_m):
-    solids_m3 = BEADS * 4.0 / 3.0 * math.pi * RADIUS_M**3
-    return 1.0 - solids_m3 / (WIDTH_M * DEPTH_M * 2.0 * h_m)
+    return slab_porosity(BEADS, RADIUS_M, WIDTH_M, DEPTH_M, h_m)
 
 
 def umf_at(porosity):
