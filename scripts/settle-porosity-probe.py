@@ -16,7 +16,6 @@ Needs PyYAML.
 import argparse
 import copy
 import json
-import math
 import os
 import sys
 
