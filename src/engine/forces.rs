@@ -713,17 +713,29 @@ pub struct RangePlan {
 }
 
 impl RangePlan {
-    /// Ranges per thread. More ranges than threads let a thread that the machine delays hand its unstarted ranges
-    /// to the other threads (see `Team::map_parts`), at the price of more pairs crossing a range boundary. Measured
-    /// on the benchmark column with 2 threads (`granflow bench dem --threads 2 --speedup`, 2026-12-01): 2 per thread
-    /// gave speed-ups of 1.79-1.82, 4 gave 1.78-1.80 (and 1.69-1.73 at 8,000 steps), 8 gave 1.68, 16 gave 1.55-1.58.
-    /// On 2026-12-03, two two-thread simulations interleaved in one process (a probe): 3 per thread took 0.998 and 4
-    /// took 1.020 times as long as 2 (the same code against itself: 1.003).
-    pub const PER_THREAD: usize = 2;
+    /// The cost shares of one thread's ranges, front to back: one large range and two small ones at the back.
+    ///
+    /// A thread works through its own ranges from the front and, when done, takes the other threads' unstarted
+    /// ranges from their backs (`Team::map_parts`). The virtual machine makes a thread's time for the same work
+    /// vary from step to step (a median 3 %, 13 % at the 90th percentile), so the two threads finish phase B on
+    /// average 10 % of the phase apart; small ranges at the back of each block let the thread that finishes first
+    /// take over the other's last few percent. Equal ranges cannot do that: a range large enough to keep the
+    /// boundary pairs few is larger than the usual lead. Measured with two two-thread simulations interleaved in one
+    /// process with the one-thread reference (a probe of `bench dem --speedup`, 2026-12-03, 20,000 steps), time
+    /// against two equal ranges per thread: 0.970, 0.980, 0.962, 0.952 for [0.8, 0.12, 0.08]; 0.947, 0.992 for
+    /// [0.85, 0.1, 0.05]; 0.987 for [0.7, 0.2, 0.1]; 0.958 for [0.8, 0.1, 0.06, 0.04]; the same layout against
+    /// itself 0.987, 0.984, 1.017, 0.975. Earlier (2026-12-01, 2026-12-03), equal ranges: 2 per thread beat 4, 8
+    /// and 16 per thread, and 3 took 0.998 times as long as 2.
+    pub const BLOCK: [f64; 3] = [0.8, 0.12, 0.08];
 
-    /// How many ranges `threads` threads work on (one range, the serial pass, on one thread).
-    pub fn ranges_for(threads: usize) -> usize {
-        if threads <= 1 { 1 } else { threads * Self::PER_THREAD }
+    /// The cost shares of the ranges that `threads` threads work on: `block` (one thread's ranges, front to back)
+    /// once per thread; one range, the serial pass, on one thread.
+    pub fn shares_for(threads: usize, block: &[f64]) -> Vec<f64> {
+        if threads <= 1 || block.is_empty() {
+            vec![1.0]
+        } else {
+            (0..threads).flat_map(|_| block.iter().copied()).collect()
+        }
     }
 
     /// Estimated relative cost of particle i: one unit for the particle, a quarter per candidate pair, two per
@@ -760,8 +772,9 @@ impl RangePlan {
         }
     }
 
-    /// A plan of `ranges` parts of equal cost, where the cost of each particle is its estimate scaled by the
-    /// measured time per unit of estimate of the range that held it in `previous` (when that plan has timings).
+    /// A plan of one range per entry of `shares`, each holding that share of the cost (equal shares if any is not
+    /// positive and finite), where the cost of each particle is its estimate scaled by the measured time per unit of
+    /// estimate of the range that held it in `previous` (when that plan has timings).
     ///
     /// Made at every neighbour-list rebuild, so it must cost little next to a step: one pass over every pair slot,
     /// in chunks on `team`, gives each chunk's summed estimate and cost and the furthest partner of its particles;
@@ -770,12 +783,20 @@ impl RangePlan {
     pub fn balanced(
         list: &NeighborList,
         touching: &[bool],
-        ranges: usize,
+        shares: &[f64],
         previous: Option<&RangePlan>,
         team: &Team,
     ) -> RangePlan {
         let n = list.start.len().saturating_sub(1);
-        let ranges = ranges.clamp(1, n.max(1));
+        let ranges = shares.len().clamp(1, n.max(1));
+        // Cumulative share before range k, as a fraction of the whole (equal shares when they are unusable).
+        let usable = ranges == shares.len() && shares.iter().all(|&w| w.is_finite() && w > 0.0);
+        let share_sum: f64 = if usable { shares.iter().sum() } else { ranges as f64 };
+        let mut share_before = vec![0.0f64];
+        for k in 0..ranges {
+            let w = if usable { shares[k] } else { 1.0 };
+            share_before.push(share_before[k] + w);
+        }
         if ranges == 1 {
             // The serial pass: nothing to balance or to cross.
             return RangePlan {
@@ -822,7 +843,7 @@ impl RangePlan {
 
         // Bound k is the first particle before which the summed cost reaches k/ranges of the total.
         let total: f64 = chunks.iter().map(|c| c.cost).sum();
-        let target = |k: usize| total * k as f64 / ranges as f64;
+        let target = |k: usize| total * share_before[k] / share_sum;
         let mut bounds = vec![0usize];
         let (mut running, mut next) = (0.0, 1);
         for (c, chunk) in chunks.iter().enumerate() {
@@ -909,7 +930,7 @@ impl RangePlan {
     }
 }
 
-/// Several threads: the particles are cut into [`RangePlan::PER_THREAD`] contiguous ranges per thread, which the
+/// Several threads: the particles are cut into contiguous ranges, [`RangePlan::BLOCK`] per thread, which the
 /// team shares out with work stealing (`Team::map_parts`).
 ///
 /// Phase A computes, in parallel, only the pairs whose partner lies in a later range (the pairs two ranges share),
@@ -1283,14 +1304,23 @@ mod tests {
     }
 
     /// The plan made from chunk sums equals what its definition gives particle by particle: bound k is the first
-    /// particle before which the summed (speed-scaled) cost reaches k/ranges of the total, `cross_from` the first
+    /// particle before which the summed (speed-scaled) cost reaches the first k ranges' share of the total, `cross_from` the first
     /// particle of a range with a partner beyond it, `incoming` every slot whose partner lies in a later range; on one
     /// thread and on two.
     #[test]
     fn balanced_plan_matches_its_definition_particle_by_particle() {
-        for (n, ranges, seed) in [(5000, 4, 1), (3000, 7, 2), (1500, 2, 3), (40, 4, 4)] {
+        let block = RangePlan::shares_for(2, &RangePlan::BLOCK);
+        for (n, shares, seed) in [
+            (5000, vec![1.0; 4], 1),
+            (3000, vec![1.0; 7], 2),
+            (1500, vec![1.0; 2], 3),
+            (40, vec![1.0; 4], 4),
+            (4000, block.clone(), 5),
+            (3000, vec![0.5, 3.0, 0.25, 1.0, 0.1], 6),
+        ] {
+            let ranges = shares.len();
             let (list, touching) = random_list(n, seed);
-            let first = RangePlan::balanced(&list, &touching, ranges, None, &Team::new(1));
+            let first = RangePlan::balanced(&list, &touching, &shares, None, &Team::new(1));
             // Give the first plan unequal timings, so that the next is scaled by speed.
             for (r, busy) in first.busy_ns.iter().enumerate() {
                 busy.store(
@@ -1299,7 +1329,7 @@ mod tests {
                 );
             }
             for team in [Team::new(1), Team::new(2)] {
-                let plan = RangePlan::balanced(&list, &touching, ranges, Some(&first), &team);
+                let plan = RangePlan::balanced(&list, &touching, &shares, Some(&first), &team);
                 let per_unit: Vec<f64> = first
                     .busy_ns
                     .iter()
@@ -1317,7 +1347,7 @@ mod tests {
                 for k in 1..ranges {
                     let b = plan.bounds[k];
                     let before: f64 = cost[..b].iter().sum();
-                    let target = total * k as f64 / ranges as f64;
+                    let target = total * shares[..k].iter().sum::<f64>() / shares.iter().sum::<f64>();
                     assert!(before >= target * (1.0 - 1e-12), "bound {k} = {b} comes too early");
                     assert!(
                         b == 0 || before - cost[b - 1] < target * (1.0 + 1e-12),

@@ -108,6 +108,8 @@ pub struct Simulation {
     inverse: InverseInertia,
     /// Particle ranges of the parallel force pass, rebalanced at every neighbour-list build.
     ranges: RangePlan,
+    /// Cost shares of one thread's ranges, front to back (see [`RangePlan::shares_for`]).
+    pub range_block: Vec<f64>,
     /// Set between two steps of one `run_steps` call when the force loop has already applied the next step's
     /// first half kick and drift: the largest squared displacement it found. Never set outside `run_steps`.
     pending_drift: Option<f64>,
@@ -158,6 +160,7 @@ impl Simulation {
             buffers: PairBuffers::default(),
             inverse,
             ranges: RangePlan::default(),
+            range_block: RangePlan::BLOCK.to_vec(),
             pending_drift: None,
             gas: None,
             net_force: None,
@@ -195,6 +198,7 @@ impl Simulation {
             buffers: PairBuffers::default(),
             inverse,
             ranges: RangePlan::default(),
+            range_block: RangePlan::BLOCK.to_vec(),
             pending_drift: None,
             gas: None,
             net_force: state.net_force,
@@ -594,7 +598,7 @@ impl Simulation {
         self.ranges = RangePlan::balanced(
             &self.list,
             &self.history.pair.touching,
-            RangePlan::ranges_for(self.threads()),
+            &RangePlan::shares_for(self.threads(), &self.range_block),
             Some(&self.ranges),
             &self.team,
         );
