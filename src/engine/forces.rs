@@ -789,14 +789,19 @@ impl RangePlan {
     ) -> RangePlan {
         let n = list.start.len().saturating_sub(1);
         let ranges = shares.len().clamp(1, n.max(1));
-        // Cumulative share before range k, as a fraction of the whole (equal shares when they are unusable).
-        let usable = ranges == shares.len() && shares.iter().all(|&w| w.is_finite() && w > 0.0);
-        let share_sum: f64 = if usable { shares.iter().sum() } else { ranges as f64 };
-        let mut share_before = vec![0.0f64];
-        for k in 0..ranges {
-            let w = if usable { shares[k] } else { 1.0 };
-            share_before.push(share_before[k] + w);
-        }
+        let shares = if ranges == shares.len() && shares.iter().all(|&w| w.is_finite() && w > 0.0) {
+            shares.to_vec()
+        } else {
+            vec![1.0; ranges]
+        };
+        // The summed shares of the ranges before range k.
+        let share_before: Vec<f64> = std::iter::once(0.0)
+            .chain(shares.iter().scan(0.0, |sum, &w| {
+                *sum += w;
+                Some(*sum)
+            }))
+            .collect();
+        let share_sum = share_before[ranges];
         if ranges == 1 {
             // The serial pass: nothing to balance or to cross.
             return RangePlan {
@@ -841,7 +846,7 @@ impl RangePlan {
         });
         let chunk_of = |c: usize| c * BUILD_CHUNK..((c + 1) * BUILD_CHUNK).min(n);
 
-        // Bound k is the first particle before which the summed cost reaches k/ranges of the total.
+        // Bound k is the first particle before which the summed cost reaches the first k ranges' share of the total.
         let total: f64 = chunks.iter().map(|c| c.cost).sum();
         let target = |k: usize| total * share_before[k] / share_sum;
         let mut bounds = vec![0usize];
@@ -1304,9 +1309,9 @@ mod tests {
     }
 
     /// The plan made from chunk sums equals what its definition gives particle by particle: bound k is the first
-    /// particle before which the summed (speed-scaled) cost reaches the first k ranges' share of the total, `cross_from` the first
-    /// particle of a range with a partner beyond it, `incoming` every slot whose partner lies in a later range; on one
-    /// thread and on two.
+    /// particle before which the summed (speed-scaled) cost reaches the first k ranges' share of the total,
+    /// `cross_from` the first particle of a range with a partner beyond it, `incoming` every slot whose partner lies
+    /// in a later range; on one thread and on two, with equal and unequal shares.
     #[test]
     fn balanced_plan_matches_its_definition_particle_by_particle() {
         let block = RangePlan::shares_for(2, &RangePlan::BLOCK);
