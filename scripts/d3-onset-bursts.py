@@ -11,27 +11,23 @@ Usage: python3 scripts/d3-onset-bursts.py RESULTS_DIR [--threshold 0.01] > OUT.m
 """
 
 import argparse
-import csv
 import json
 import math
 import os
 import statistics
 import sys
 
+from reportlib import read_job
+
 
 def level_sigmas(job_dir, threshold):
-    job = json.load(open(os.path.join(job_dir, "job.json")))
-    params = {k.split(".")[-1]: v for k, v in job["params"]}
-    result = json.load(open(os.path.join(job_dir, "result.json")))
-    metrics = {m["name"]: m["value"] for m in result["metrics"]}
-    gas = job["scenario"]["gas"]
+    full_params, metrics, rows = read_job(job_dir)
+    params = {k.split(".")[-1]: v for k, v in full_params.items()}
+    gas = json.load(open(os.path.join(job_dir, "scenario.json")))["gas"]
     levels = gas["inflow_levels"]
     inlet = gas["sides"]["y_low"]["inlet"]["superficial_velocity_m_per_s"]
-    times, dp = [], []
-    with open(os.path.join(job_dir, "series.csv")) as fh:
-        for row in csv.DictReader(fh):
-            times.append(float(row["time_s"]))
-            dp.append(float(row["column_pressure_drop_pa"]))
+    times = [float(r["time_s"]) for r in rows]
+    dp = [float(r["column_pressure_drop_pa"]) for r in rows]
     weight = metrics["bed_weight_per_area_pa"]
     out = []
     for k, factor in enumerate(levels["factors"]):

@@ -1,8 +1,10 @@
 """Helpers shared by the probe scripts: reading a `granflow report` job table and the campaign YAML, and running
 scenarios with `granflow simulate`."""
 
+import csv
 import json
 import math
+import os
 import re
 import subprocess
 from concurrent.futures import ThreadPoolExecutor
@@ -22,6 +24,19 @@ def job_rows(path):
     if not rows:
         raise SystemExit(f"{path}: no finished jobs in its job table")
     return rows
+
+
+def read_job(job_dir):
+    """A job's directory: its parameters by full key, its metrics by name (None until the job has finished) and
+    its series rows (dicts of column name to text)."""
+    params = dict(json.load(open(os.path.join(job_dir, "job.json")))["params"])
+    result = os.path.join(job_dir, "result.json")
+    metrics = None
+    if os.path.exists(result):
+        metrics = {m["name"]: m["value"] for m in json.load(open(result))["metrics"]}
+    with open(os.path.join(job_dir, "series.csv")) as fh:
+        rows = list(csv.DictReader(fh))
+    return params, metrics, rows
 
 
 def slab_porosity(beads, radius_m, width_m, depth_m, mean_height_m):

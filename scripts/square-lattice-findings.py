@@ -29,7 +29,7 @@ import json
 import math
 import os
 
-from reportlib import load_campaign, simulate_all, slab_porosity
+from reportlib import load_campaign, read_job, simulate_all, slab_porosity
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 spec = importlib.util.spec_from_file_location("packing", os.path.join(HERE, "d2-packing-porosity.py"))
@@ -60,16 +60,13 @@ def umf_at(porosity):
 
 
 def job_summary(job_dir):
-    params = dict(json.load(open(os.path.join(job_dir, "job.json")))["params"])
-    rows = list(csv.DictReader(open(os.path.join(job_dir, "series.csv"))))
+    params, metrics, rows = read_job(job_dir)
     t = [float(r["time_s"]) for r in rows]
     h = [float(r["mean_height_m"]) for r in rows]
     settled = [hh for tt, hh in zip(t, h) if 0.4 <= tt < 0.5]
     fell = next((tt for tt, hh in zip(t, h) if hh < 0.98 * h[0]), None)
     umf, state = None, f"stopped at {t[-1]:.2f} s"
-    result = os.path.join(job_dir, "result.json")
-    if os.path.exists(result):
-        metrics = {m["name"]: m["value"] for m in json.load(open(result))["metrics"]}
+    if metrics is not None:
         umf = metrics.get("stepped_fluidization_velocity_m_per_s")
         state = "done"
     return {
