@@ -784,11 +784,11 @@ impl RangePlan {
     /// estimate of the range that held it in `previous` (when that plan has timings).
     ///
     /// Made at every neighbour-list rebuild, so it must cost little next to a step: one pass over every pair slot,
-    /// in chunks on `team`, gives each chunk's summed estimate and cost and the furthest partner of its particles
-    /// (each from the chunk's slot range as a whole: a vectorised count of touching flags and a maximum, not a loop
-    /// per particle, which made plans 0.8 % of a two-thread run); the bounds, the first particle of each range with a
-    /// partner beyond it and each range's estimate then need only the chunk sums and a scan of the few chunks where a
-    /// bound falls.
+    /// in chunks on `team`, gives each chunk's summed cost and the furthest partner of its particles (each from the
+    /// chunk's slot range as a whole: a vectorised count of touching flags and a maximum, not a loop per particle,
+    /// which made plans 0.8 % of a two-thread run); the bounds and the first particle of each range with a partner
+    /// beyond it then need only the chunk sums and a scan of the few chunks where a bound falls, and each range's
+    /// estimate one count over its slots.
     pub fn balanced(
         list: &NeighborList,
         touching: &[bool],
@@ -835,7 +835,6 @@ impl RangePlan {
         let old = speed.as_deref().zip(previous).map(|(speed, p)| (&p.bounds[..], speed));
         let last_partner = |i: usize| list.pairs_of(i).next_back().map_or(0, |k| list.partner[k] as usize);
         struct ChunkCost {
-            estimate: f64,
             cost: f64,
             /// The largest partner index of the chunk's particles (0: none; a partner is never particle 0).
             last_partner: usize,
@@ -844,7 +843,6 @@ impl RangePlan {
             let slots = list.start[particles.start] as usize..list.start[particles.end] as usize;
             // Partners are ascending per particle, so the largest partner of any slot is the largest last partner.
             let last_partner = list.partner[slots].iter().copied().max().map_or(0, |j| j as usize);
-            let estimate = Self::span_estimate(list, touching, particles.clone());
             // The chunk's pieces in each range of the old plan, each scaled by that range's speed.
             let cost = match old {
                 Some((bounds, speed)) => {
@@ -857,13 +855,9 @@ impl RangePlan {
                     }
                     cost
                 }
-                None => estimate,
+                None => Self::span_estimate(list, touching, particles),
             };
-            ChunkCost {
-                estimate,
-                cost,
-                last_partner,
-            }
+            ChunkCost { cost, last_partner }
         });
         let chunk_of = |c: usize| c * BUILD_CHUNK..((c + 1) * BUILD_CHUNK).min(n);
 
@@ -909,20 +903,7 @@ impl RangePlan {
             })
             .collect();
         let estimate = (0..ranges)
-            .map(|r| {
-                let (mut i, hi) = (bounds[r], bounds[r + 1]);
-                let mut sum = 0.0;
-                while i < hi {
-                    let particles = chunk_of(i / BUILD_CHUNK);
-                    if i == particles.start && particles.end <= hi {
-                        sum += chunks[i / BUILD_CHUNK].estimate;
-                    } else {
-                        sum += Self::span_estimate(list, touching, i..particles.end.min(hi));
-                    }
-                    i = particles.end.min(hi);
-                }
-                sum
-            })
+            .map(|r| Self::span_estimate(list, touching, bounds[r]..bounds[r + 1]))
             .collect();
         // Ranges are scanned in ascending order and each range's particles ascending, so every target range gets
         // its incoming slots in ascending first particle.
