@@ -7,7 +7,9 @@ window: a sensitivity check of `pressure_overshoot_ratio` (src/analysis/fluidiza
 Each level's ΔP* is the mean ΔP over [start + f·hold, end of the level) over the mean W'/A there (the first-node
 reading), or over W/A of the whole bed with --column; the peak is the top of the rising branch's climb, as in the
 reducer. Prints one line per job and the mean peak per cohesion setting."""
-import argparse, csv, json, os, sqlite3
+import argparse, json, os, sqlite3
+
+from reportlib import read_job
 
 ap = argparse.ArgumentParser()
 ap.add_argument("dir")
@@ -17,17 +19,17 @@ args = ap.parse_args()
 
 db = sqlite3.connect(os.path.join(args.dir, "campaign.sqlite"))
 groups = {}
-for job_id, params in db.execute("SELECT job_id, params_json FROM jobs WHERE status = 'done' ORDER BY ordinal"):
-    scenario = json.load(open(os.path.join(args.dir, "jobs", job_id, "scenario.json")))
+for (job_id,) in db.execute("SELECT job_id FROM jobs WHERE status = 'done' ORDER BY ordinal"):
+    job_dir = os.path.join(args.dir, "jobs", job_id)
+    p, metrics, rows = read_job(job_dir)
+    scenario = json.load(open(os.path.join(job_dir, "scenario.json")))
     gas = scenario["gas"]
     levels = gas["inflow_levels"]
     u = max(j["superficial_velocity_m_per_s"] for j in gas["jets"]) * len(gas["jets"]) / gas["cells"][0]
-    rows = list(csv.DictReader(open(os.path.join(args.dir, "jobs", job_id, "series.csv"))))
     t = [float(r["time_s"]) for r in rows]
     dp = [float(r["column_pressure_drop_pa" if args.column else "node_pressure_drop_pa"]) for r in rows]
     w = None if args.column else [float(r["node_weight_per_area_pa"]) for r in rows]
-    result = json.load(open(os.path.join(args.dir, "jobs", job_id, "result.json")))
-    whole = next(m["value"] for m in result["metrics"] if m["name"] == "bed_weight_per_area_pa")
+    whole = metrics["bed_weight_per_area_pa"]
     star = []
     for k, f in enumerate(levels["factors"]):
         a = levels["start_s"] + (k + args.from_fraction) * levels["hold_s"]
@@ -42,7 +44,6 @@ for job_id, params in db.execute("SELECT job_id, params_json FROM jobs WHERE sta
     while k < len(rising) and rising[k][1] >= rising[k - 1][1]:
         k += 1
     peak = rising[k - 1]
-    p = json.loads(params)
     key = json.dumps(p.get("cohesion"))
     groups.setdefault(key, []).append(peak[1])
     print(f"{job_id} {key} seed {p.get('seed')}: peak ΔP* {peak[1]:.4f} at {peak[0]:.4f} m/s")
