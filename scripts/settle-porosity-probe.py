@@ -78,11 +78,11 @@ def main():
                 if rolling > 0.0:
                     s["contact"]["rolling"] = "constant_directional_torque"
                 s["seed"] = seed
-                # (D3's restitution keeps the names of the runs made before the option existed.)
-                e_tag = "" if restitution == D3_RESTITUTION else f"-e{restitution:g}"
-                e_tag += "" if friction == D3_FRICTION else f"-mu{friction:g}"
-                e_tag += "" if rolling == 0.0 else f"-mur{rolling:g}"
-                s["name"] = f"E{modulus:g}{e_tag}-jitter{jitter:g}-s{seed}"
+                # (D3's own values keep the names of the runs made before the options existed.)
+                tag = "" if restitution == D3_RESTITUTION else f"-e{restitution:g}"
+                tag += "" if friction == D3_FRICTION else f"-mu{friction:g}"
+                tag += "" if rolling == 0.0 else f"-mur{rolling:g}"
+                s["name"] = f"E{modulus:g}{tag}-jitter{jitter:g}-s{seed}"
                 path = os.path.join(args.out, s["name"] + ".json")
                 with open(path, "w") as fh:
                     json.dump(s, fh)
