@@ -7,6 +7,9 @@ pub const MODELS: &str = r#"contact.normal (one of):
   thornton: { plastic_slope: continuous | seed_printed }                 seed 000 eqs. 2.3-2.9; species.yield_force_n
 contact.tangential (one of):
   linear_spring_coulomb: { stiffness_n_per_m, damping_kg_per_s }       seed 001 eqs. 6.20-6.24, seed 002 eq. 22
+  linear_step_spring_coulomb: { stiffness_n_per_m, damping_kg_per_s }  seed 001 eq. 6.24 read literally: spring
+                                                                         on this step's Δt v_t only (no static
+                                                                         friction)
   mindlin                                                                k_t = 8 G* a, LIGGGHTS tangential history
   walton_braun: { exponent }                                             seed 000 eqs. 2.10-2.13 (exponent default 1/3)
 contact.rolling (optional, default none):
@@ -59,6 +62,10 @@ mod tests {
         ];
         let tangentials = [
             TangentialModel::LinearSpringCoulomb {
+                stiffness_n_per_m: 800.0,
+                damping_kg_per_s: 1e-3,
+            },
+            TangentialModel::LinearStepSpringCoulomb {
                 stiffness_n_per_m: 800.0,
                 damping_kg_per_s: 1e-3,
             },

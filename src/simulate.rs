@@ -11,7 +11,7 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Instant;
 
 use crate::checkpoint::{CheckpointMeta, CheckpointSeries};
-use crate::engine::Simulation;
+use crate::engine::{Simulation, Vec3};
 use crate::error::{Error, Result};
 use crate::scenario::{self, BuiltScenario};
 
@@ -89,15 +89,19 @@ pub fn series_header(built: &BuiltScenario) -> String {
     if built.spec.output.net_forces {
         header.push_str(",weight_n,fluid_force_up_n");
         for wall in &built.config.walls {
-            header.push_str(&format!(",wall_{0}_contact_up_n,wall_{0}_cohesion_up_n", wall.name));
+            header.push_str(&format!(
+                ",wall_{0}_contact_up_n,wall_{0}_cohesion_up_n,wall_{0}_contact_across_n,wall_{0}_cohesion_across_n",
+                wall.name
+            ));
         }
     }
     header
 }
 
 /// The net-force columns (`output.net_forces`): the weight, and the components against gravity of the gas's force
-/// and of each wall's contact and cohesion forces on all particles, averaged over the steps since the previous
-/// reading (`nan` before any step). Reading restarts the sums.
+/// and of each wall's contact and cohesion forces on all particles, then for each wall the size of those two
+/// forces' part across gravity (for a sidewall its normal load and its pull; for a distributor its friction),
+/// averaged over the steps since the previous reading (`nan` before any step). Reading restarts the sums.
 fn net_force_columns(sim: &mut Simulation, built: &BuiltScenario) -> String {
     if !built.spec.output.net_forces {
         return String::new();
@@ -106,20 +110,23 @@ fn net_force_columns(sim: &mut Simulation, built: &BuiltScenario) -> String {
     let weight_n = sim.particles.mass_kg.iter().sum::<f64>() * g.norm();
     let means = sim.net_force.as_mut().and_then(|t| t.take_means());
     let walls = sim.config.walls.len();
-    let (fluid, per_wall): (f64, Vec<(f64, f64)>) = match (means, (-g).try_normalize(0.0)) {
+    let across = |f: &Vec3, up: &Vec3| (f - up * f.dot(up)).norm();
+    let (fluid, per_wall): (f64, Vec<[f64; 4]>) = match (means, (-g).try_normalize(0.0)) {
         (Some(m), Some(up)) => (
             m.fluid_n.dot(&up),
             m.wall_contact_n
                 .iter()
                 .zip(&m.wall_cohesion_n)
-                .map(|(c, h)| (c.dot(&up), h.dot(&up)))
+                .map(|(c, h)| [c.dot(&up), h.dot(&up), across(c, &up), across(h, &up)])
                 .collect(),
         ),
-        _ => (f64::NAN, vec![(f64::NAN, f64::NAN); walls]),
+        _ => (f64::NAN, vec![[f64::NAN; 4]; walls]),
     };
     let mut out = format!(",{weight_n:e},{fluid:e}");
-    for (contact, cohesion) in per_wall {
-        out.push_str(&format!(",{contact:e},{cohesion:e}"));
+    for [contact, cohesion, contact_across, cohesion_across] in per_wall {
+        out.push_str(&format!(
+            ",{contact:e},{cohesion:e},{contact_across:e},{cohesion_across:e}"
+        ));
     }
     out
 }

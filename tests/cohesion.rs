@@ -479,3 +479,84 @@ fn a_wet_bead_bridges_to_the_floor_only_when_wall_bridges_are_on() {
         "the bridge, more than the weight, presses the bead down"
     );
 }
+
+/// One seed-001 bead (1 mm, 2650 kg/m³, linear contacts) placed against a sidewall that attracts it (Hamaker,
+/// `walls: true`), in one layer, recording net forces, with the tangential model `tangential`.
+fn bead_on_sidewall(tangential: &str) -> String {
+    format!(
+        r#"
+name: bead-on-sidewall
+domain: {{ lo_m: [0.0, 0.0, 0.0], hi_m: [0.01, 0.1, 0.001] }}
+pseudo_2d: true
+gravity: {{ vector_m_per_s2: [0.0, -9.81, 0.0] }}
+species:
+  - {{ name: sand, radius_m: 0.0005, density_kg_per_m3: 2650.0, youngs_modulus_pa: 1.0e7, poisson_ratio: 0.3, friction_coefficient: 0.3 }}
+contact:
+  normal: {{ linear_spring_dashpot: {{ stiffness_n_per_m: 800.0, damping_kg_per_s: 0.00079 }} }}
+  tangential: {{ {tangential}: {{ stiffness_n_per_m: 800.0, damping_kg_per_s: 0.00079 }} }}
+walls: [ {{ box: {{ species: sand }} }} ]
+cohesion: {{ hamaker: {{ constant_j: 7.49e-19, inner_cutoff_m: 4.0e-10, outer_cutoff_m: 5.0e-6, walls: true }} }}
+fill:
+  - lattice: {{ species: sand, spacing_m: 0.004, lo_m: [0.0, 0.079, 0.0], hi_m: [0.002, 0.081, 0.001], origin_m: [0.0005, 0.08, 0.0005] }}
+time: {{ dt_s: 2.25e-5, end_time_s: 0.04 }}
+output: {{ series_every_steps: 100, net_forces: true }}
+"#
+    )
+}
+
+/// A bead that a sidewall attracts rolls down it (seed 001 ch. 8: "cohesion with the sidewalls ... only raises the
+/// normal load and hence the friction"). Across gravity the wall pushes as hard as it pulls, A R/(6 H_cut²) (about 29
+/// bead weights); along it, rolling without slip needs a friction of 2/7 of the weight (I = 2/5 m R²: the bead falls
+/// at 5/7 g), far below μ times that load. The same holds for seed 001's eq 6.24 read per step
+/// (`linear_step_spring_coulomb`), whose friction comes from a steady slip instead of a stretched spring. Checks the
+/// series' `*_across_n` columns and the sidewall's friction in `*_contact_up_n`.
+#[test]
+fn a_bead_attracted_to_a_sidewall_rolls_down_it_held_by_two_sevenths_of_its_weight() {
+    let pull_n = 7.49e-19 * 0.0005 / (6.0 * 4.0e-10 * 4.0e-10);
+    for tangential in ["linear_spring_coulomb", "linear_step_spring_coulomb"] {
+        let tmp = tempfile::tempdir().expect("temp dir");
+        let dir = tmp.path();
+        std::fs::write(dir.join("bead.yaml"), bead_on_sidewall(tangential)).unwrap();
+        let out = granflow(&["simulate", "bead.yaml", "--out", "bead", "--quiet"], dir);
+        assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+        let series = std::fs::read_to_string(dir.join("bead/series.csv")).unwrap();
+        let header: Vec<&str> = series.lines().next().unwrap().split(',').collect();
+        let last: Vec<f64> = series
+            .lines()
+            .last()
+            .unwrap()
+            .split(',')
+            .map(|f| f.parse().unwrap())
+            .collect();
+        let value = |name: &str| last[header.iter().position(|h| *h == name).expect(name)];
+        let weight_n = value("weight_n");
+        assert!(
+            pull_n > 25.0 * weight_n,
+            "{pull_n:e} N against a weight of {weight_n:e} N"
+        );
+        let pull = value("wall_box_x_lo_cohesion_across_n");
+        assert!(
+            (pull - pull_n).abs() < 1e-9 * pull_n,
+            "{tangential}: pull {pull:e} N, expected {pull_n:e} N"
+        );
+        let push = value("wall_box_x_lo_contact_across_n");
+        assert!(
+            (push - pull_n).abs() < 1e-3 * pull_n,
+            "{tangential}: push {push:e} N against pull {pull_n:e} N"
+        );
+        let friction = value("wall_box_x_lo_contact_up_n");
+        assert!(
+            (friction / weight_n - 2.0 / 7.0).abs() < 1e-3,
+            "{tangential}: friction {:.4} of the weight, expected 2/7",
+            friction / weight_n
+        );
+        assert_eq!(value("wall_box_x_lo_cohesion_up_n"), 0.0);
+        for other in ["box_x_hi", "box_y_lo", "box_y_hi"] {
+            assert_eq!(
+                value(&format!("wall_{other}_contact_across_n")),
+                0.0,
+                "{tangential}: {other}"
+            );
+        }
+    }
+}

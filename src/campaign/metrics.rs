@@ -270,6 +270,12 @@ pub const METRICS: &[MetricInfo] = &[
         needs: &[Need::Gas, Need::InflowLevels, Need::NetForces],
     },
     MetricInfo {
+        name: "overshoot_sidewall_normal_load_per_weight",
+        unit: "1",
+        description: "the same for the sidewalls' normal load: the size of their contact forces across gravity, summed over the sidewalls (with μ, the friction they could hold; the thesis: cohesion with the sidewalls only raises this load)",
+        needs: &[Need::Gas, Need::InflowLevels, Need::NetForces],
+    },
+    MetricInfo {
         name: "stepped_fluidization_velocity_m_per_s",
         unit: "m/s",
         description: "u_mf of a gas.inflow_levels run stepping the gas up: the slowest level of the rising branch from which the bed keeps moving (σ(ΔP) over the second half of each hold ≥ 1 % of W/A) at every faster level; NaN when the levels do not bracket the onset",

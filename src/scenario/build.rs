@@ -339,6 +339,19 @@ fn check_contact_law(c: &Checker, law: &ContactLaw) -> Result<(), ConfigError> {
                 damping_kg_per_s,
             )?;
         }
+        TangentialModel::LinearStepSpringCoulomb {
+            stiffness_n_per_m,
+            damping_kg_per_s,
+        } => {
+            c.non_negative(
+                "contact.tangential.linear_step_spring_coulomb.stiffness_n_per_m",
+                stiffness_n_per_m,
+            )?;
+            c.non_negative(
+                "contact.tangential.linear_step_spring_coulomb.damping_kg_per_s",
+                damping_kg_per_s,
+            )?;
+        }
         TangentialModel::Mindlin | TangentialModel::WaltonBraun { .. } if !hertzian => {
             return Err(c.fail(
                 "contact.tangential",

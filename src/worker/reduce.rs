@@ -221,6 +221,9 @@ pub fn metrics(job: &JobSpec, built: &BuiltScenario, sim: &Simulation, series: &
             "overshoot_sidewall_friction_per_weight" => {
                 overshoot_net_force(NetForcePart::SidewallFriction, cycle(), sim, series)
             }
+            "overshoot_sidewall_normal_load_per_weight" => {
+                overshoot_net_force(NetForcePart::SidewallNormalLoad, cycle(), sim, series)
+            }
             "stepped_fluidization_velocity_m_per_s" => stepped_onset_m_per_s(job, built, sim, series),
             other => return Err(Error::External(format!("metric `{other}` has no reducer"))),
         };
@@ -423,10 +426,12 @@ enum NetForcePart {
     DistributorContact,
     DistributorCohesion,
     SidewallFriction,
+    SidewallNormalLoad,
 }
 
 /// A net-force part over the weight, averaged over the second half of the cycle's overshoot peak level (the
-/// climb's top): the series' `*_up_n` columns over `weight_n`. The distributor is every plane wall whose normal
+/// climb's top): the series' `*_up_n` columns (the sidewalls' normal load: their `*_contact_across_n` columns)
+/// over `weight_n`. The distributor is every plane wall whose normal
 /// points against gravity, the sidewalls every plane wall parallel to it (normals checked at the bed's centroid).
 fn overshoot_net_force(part: NetForcePart, cycle: Option<&Cycle>, sim: &Simulation, series: &Series) -> f64 {
     let Some(cycle) = cycle else {
@@ -468,6 +473,10 @@ fn overshoot_net_force(part: NetForcePart, cycle: Option<&Cycle>, sim: &Simulati
         NetForcePart::SidewallFriction => walls(&|c| c.abs() < PARALLEL)
             .iter()
             .flat_map(|w| [format!("wall_{w}_contact_up_n"), format!("wall_{w}_cohesion_up_n")])
+            .collect(),
+        NetForcePart::SidewallNormalLoad => walls(&|c| c.abs() < PARALLEL)
+            .iter()
+            .map(|w| format!("wall_{w}_contact_across_n"))
             .collect(),
     };
     let Some(columns) = columns

@@ -21,6 +21,14 @@ pub enum TangentialModel {
         stiffness_n_per_m: f64,
         damping_kg_per_s: f64,
     },
+    /// Seed 001 eqs. 6.20–6.24 read literally: the spring acts on this step's displacement only, δ_t = Δt v_t
+    /// (eq. 6.24), not on one accumulated over the contact. The force is then a dashpot, −(K_t Δt + η_t) v_t,
+    /// truncated at μF_n: there is no static friction, and friction acts only while the surfaces slide. The
+    /// extraction leaves open whether the thesis accumulated δ_t; this model is the other reading, for probes.
+    LinearStepSpringCoulomb {
+        stiffness_n_per_m: f64,
+        damping_kg_per_s: f64,
+    },
     /// Mindlin no-slip stiffness k_t = 8 G* a on the accumulated displacement, viscoelastic damping with the normal
     /// model's restitution, truncated at μF_n: LIGGGHTS `tangential history`. Requires a Hertzian normal model.
     Mindlin,
@@ -40,6 +48,7 @@ impl TangentialModel {
     pub fn name(&self) -> &'static str {
         match self {
             TangentialModel::LinearSpringCoulomb { .. } => "linear_spring_coulomb",
+            TangentialModel::LinearStepSpringCoulomb { .. } => "linear_step_spring_coulomb",
             TangentialModel::Mindlin => "mindlin",
             TangentialModel::WaltonBraun { .. } => "walton_braun",
         }
@@ -75,6 +84,24 @@ impl TangentialModel {
                 dt_s,
                 hist,
             ),
+            TangentialModel::LinearStepSpringCoulomb {
+                stiffness_n_per_m,
+                damping_kg_per_s,
+            } => {
+                // No accumulated displacement: the spring starts from zero every step, and keeps none.
+                hist.tangential = Vec3::zeros();
+                let force = spring_with_coulomb_limit(
+                    stiffness_n_per_m,
+                    tangential_velocity * damping_kg_per_s,
+                    limit,
+                    n,
+                    tangential_velocity,
+                    dt_s,
+                    hist,
+                );
+                hist.tangential = Vec3::zeros();
+                force
+            }
             TangentialModel::Mindlin => {
                 let kt = 8.0 * mat.effective_shear_modulus_pa * normal.contact_radius_m;
                 // γ_t = 2√(5/6) β √(k_t m*) = γ_n √(k_t/S_n) (LIGGGHTS), with √(k_t/S_n) = √(4G*/E*) per pair.
@@ -235,5 +262,40 @@ mod tests {
         }
         assert!((f.norm() - 0.5).abs() < 1e-12);
         assert!(f.y < 0.0);
+    }
+
+    #[test]
+    fn step_spring_is_a_dashpot_of_kt_dt_plus_eta_capped_at_coulomb() {
+        let n = Vec3::new(1.0, 0.0, 0.0);
+        let normal = NormalOutput {
+            force_n: 1.0,
+            contact_radius_m: 0.0,
+            viscoelastic_damping_kg_per_s: 0.0,
+        };
+        let (kt, eta, dt) = (800.0, 0.79e-3, 2.25e-5);
+        let model = TangentialModel::LinearStepSpringCoulomb {
+            stiffness_n_per_m: kt,
+            damping_kg_per_s: eta,
+        };
+        let mut h = ContactHistory::default();
+        // Slow sliding: the same force every step (nothing accumulates), −(K_t Δt + η_t) v_t, μF_n = 0.5 not reached.
+        let v = Vec3::new(0.0, 1.0, 2.0);
+        for _ in 0..1000 {
+            let f = model.force(&mat(), &normal, &n, &v, dt, &mut h);
+            let expected = -v * (kt * dt + eta);
+            assert!(
+                (f - expected).norm() < 1e-15 * expected.norm().max(1.0),
+                "{f:?} vs {expected:?}"
+            );
+            assert_eq!(h.tangential, Vec3::zeros());
+        }
+        // Fast sliding: on the Coulomb limit.
+        let fast = Vec3::new(0.0, 100.0, 0.0);
+        let f = model.force(&mat(), &normal, &n, &fast, dt, &mut h);
+        assert!((f.norm() - 0.5).abs() < 1e-12);
+        assert!(f.y < 0.0);
+        // At rest it holds nothing, unlike the accumulated spring (no static friction).
+        let f = model.force(&mat(), &normal, &n, &Vec3::zeros(), dt, &mut h);
+        assert_eq!(f, Vec3::zeros());
     }
 }
