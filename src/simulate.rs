@@ -100,8 +100,9 @@ pub fn series_header(built: &BuiltScenario) -> String {
 
 /// The net-force columns (`output.net_forces`): the weight, and the components against gravity of the gas's force
 /// and of each wall's contact and cohesion forces on all particles, then for each wall the size of those two
-/// forces' part across gravity (for a sidewall its normal load and its pull; for a distributor its friction),
-/// averaged over the steps since the previous reading (`nan` before any step). Reading restarts the sums.
+/// forces' part across gravity (for a vertical sidewall its normal load and its pull, plus its horizontal friction
+/// in a 3-D bed; for a distributor its net friction), averaged over the steps since the previous reading (`nan`
+/// before any step). Reading restarts the sums.
 fn net_force_columns(sim: &mut Simulation, built: &BuiltScenario) -> String {
     if !built.spec.output.net_forces {
         return String::new();

@@ -272,7 +272,7 @@ pub const METRICS: &[MetricInfo] = &[
     MetricInfo {
         name: "overshoot_sidewall_normal_load_per_weight",
         unit: "1",
-        description: "the same for the sidewalls' normal load: the size of their contact forces across gravity, summed over the sidewalls (with μ, the friction they could hold; the thesis: cohesion with the sidewalls only raises this load)",
+        description: "the same for the sidewalls' normal load: the size of their contact forces across gravity, summed over the sidewalls (in a pseudo-2-D bed exactly their normal load; in 3-D it also holds their horizontal friction); with μ, the friction they could give (the thesis: cohesion with the sidewalls only raises this load)",
         needs: &[Need::Gas, Need::InflowLevels, Need::NetForces],
     },
     MetricInfo {

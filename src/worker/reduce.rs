@@ -431,8 +431,8 @@ enum NetForcePart {
 
 /// A net-force part over the weight, averaged over the second half of the cycle's overshoot peak level (the
 /// climb's top): the series' `*_up_n` columns (the sidewalls' normal load: their `*_contact_across_n` columns)
-/// over `weight_n`. The distributor is every plane wall whose normal
-/// points against gravity, the sidewalls every plane wall parallel to it (normals checked at the bed's centroid).
+/// over `weight_n`. The distributor is every plane wall whose normal points against gravity, the sidewalls every
+/// plane wall parallel to it (normals checked at the bed's centroid).
 fn overshoot_net_force(part: NetForcePart, cycle: Option<&Cycle>, sim: &Simulation, series: &Series) -> f64 {
     let Some(cycle) = cycle else {
         return f64::NAN;
