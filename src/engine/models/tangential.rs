@@ -88,7 +88,9 @@ impl TangentialModel {
                 stiffness_n_per_m,
                 damping_kg_per_s,
             } => {
-                // No accumulated displacement: the spring starts from zero every step, and keeps none.
+                // No accumulated displacement: the spring starts from zero every step, and keeps none. A separate
+                // arm, not an or-pattern with the one above and a flag: that changed the code generation of the
+                // whole force loop (+2.2 % instructions in `bench dem --steps 2000`, Hertz-Mindlin, callgrind).
                 hist.tangential = Vec3::zeros();
                 let force = spring_with_coulomb_limit(
                     stiffness_n_per_m,
