@@ -27,7 +27,7 @@ import glob
 import json
 import os
 
-from reportlib import read_job
+from reportlib import cycle_levels, read_job
 
 ap = argparse.ArgumentParser()
 ap.add_argument("dir", help="a campaign directory (with jobs/)")
@@ -51,20 +51,13 @@ for job_dir in sorted(glob.glob(os.path.join(args.dir, "jobs", "*"))):
     params, metrics, rows = read_job(job_dir)
     if metrics is None:
         continue
-    scenario = json.load(open(os.path.join(job_dir, "scenario.json")))
-    gas = scenario["gas"]
-    levels = gas["inflow_levels"]
-    # One-cell jets (D8): the bed's superficial velocity is the jets' velocity times their share of the cells.
-    jets = gas.get("jets") or []
-    inflow = jets[0]["superficial_velocity_m_per_s"] * len(jets) / gas["cells"][0] if jets else float("nan")
-    factors = levels["factors"]
-    slowest = min(range(len(factors)), key=lambda k: (factors[k], -k))
+    levels = cycle_levels(job_dir)
+    slowest = min(range(len(levels)), key=lambda k: levels[k][0])
     print(f"{os.path.basename(job_dir)}  {label(params)}")
     print("  lvl      U     dP*   fluid   side_f  side_n     mob  dist_c  dist_h    h_mm")
     t = [float(r["time_s"]) for r in rows]
-    for k in range(slowest, min(slowest + args.levels, len(factors))):
-        start = levels["start_s"] + k * levels["hold_s"]
-        lo, hi = start + 0.5 * levels["hold_s"], start + levels["hold_s"]
+    for k in range(slowest, min(slowest + args.levels, len(levels))):
+        u, lo, hi = levels[k]
         sel = [r for r, tk in zip(rows, t) if lo <= tk < hi]
         if not sel:
             break
@@ -85,6 +78,6 @@ for job_dir in sorted(glob.glob(os.path.join(args.dir, "jobs", "*"))):
         dist_c = mean(lambda r: col(r, f"wall_{args.distributor}_contact_up_n")) / weight
         dist_h = mean(lambda r: col(r, f"wall_{args.distributor}_cohesion_up_n")) / weight
         height = mean(lambda r: col(r, "mean_height_m")) * 1000
-        print(f"  {k:3d} {inflow * factors[k]:6.3f} {dp:7.4f} {fluid:7.4f} {side_f:+8.4f} {side_n:7.4f} {mob:+7.3f}"
+        print(f"  {k:3d} {u:6.3f} {dp:7.4f} {fluid:7.4f} {side_f:+8.4f} {side_n:7.4f} {mob:+7.3f}"
               f" {dist_c:+7.4f} {dist_h:+7.4f} {height:7.3f}")
     print()

@@ -9,7 +9,7 @@ reading), or over W/A of the whole bed with --column; the peak is the top of the
 reducer. Prints one line per job and the mean peak per cohesion setting."""
 import argparse, json, os, sqlite3
 
-from reportlib import read_job
+from reportlib import cycle_levels, read_job
 
 ap = argparse.ArgumentParser()
 ap.add_argument("dir")
@@ -22,22 +22,16 @@ groups = {}
 for (job_id,) in db.execute("SELECT job_id FROM jobs WHERE status = 'done' ORDER BY ordinal"):
     job_dir = os.path.join(args.dir, "jobs", job_id)
     p, metrics, rows = read_job(job_dir)
-    scenario = json.load(open(os.path.join(job_dir, "scenario.json")))
-    gas = scenario["gas"]
-    levels = gas["inflow_levels"]
-    u = max(j["superficial_velocity_m_per_s"] for j in gas["jets"]) * len(gas["jets"]) / gas["cells"][0]
     t = [float(r["time_s"]) for r in rows]
     dp = [float(r["column_pressure_drop_pa" if args.column else "node_pressure_drop_pa"]) for r in rows]
     w = None if args.column else [float(r["node_weight_per_area_pa"]) for r in rows]
     whole = metrics["bed_weight_per_area_pa"]
     star = []
-    for k, f in enumerate(levels["factors"]):
-        a = levels["start_s"] + (k + args.from_fraction) * levels["hold_s"]
-        b = levels["start_s"] + (k + 1) * levels["hold_s"]
+    for u, a, b in cycle_levels(job_dir, args.from_fraction):
         idx = [i for i in range(len(t)) if a <= t[i] < b]
         mean = sum(dp[i] for i in idx) / len(idx)
         weight = whole if w is None else sum(w[i] for i in idx) / len(idx)
-        star.append((u * f, mean / weight))
+        star.append((u, mean / weight))
     slowest = min(range(len(star)), key=lambda k: star[k][0])
     rising = star[slowest:]
     k = 1

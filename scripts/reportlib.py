@@ -39,6 +39,20 @@ def read_job(job_dir):
     return params, metrics, rows
 
 
+def cycle_levels(job_dir, from_fraction=0.5):
+    """The inflow levels of a job run with `gas.inflow_levels` through one-cell jets (D8's distributor): for each
+    level, its superficial velocity (the jets' velocity times their share of the inlet cells, m/s) and the window
+    [start + from_fraction × hold, end of the level) in s; the cycle metrics average over from_fraction = 0.5."""
+    gas = json.load(open(os.path.join(job_dir, "scenario.json")))["gas"]
+    levels = gas["inflow_levels"]
+    jets = gas["jets"]
+    u = max(j["superficial_velocity_m_per_s"] for j in jets) * len(jets) / gas["cells"][0]
+    return [
+        (u * f, levels["start_s"] + (k + from_fraction) * levels["hold_s"], levels["start_s"] + (k + 1) * levels["hold_s"])
+        for k, f in enumerate(levels["factors"])
+    ]
+
+
 def slab_porosity(beads, radius_m, width_m, depth_m, mean_height_m):
     """Porosity of a pseudo-2-D bed (one layer of spheres in a slab `depth_m` deep) from its beads' mean centre
     height: the bed is 2 x that height tall, φ₂ = N π R² / (W H) is its area fraction, and a sphere fills 2/3 of the
