@@ -24,7 +24,11 @@ fn packing() -> Vec<Vec3> {
     let layer = spacing * (2.0f64 / 3.0).sqrt();
     let mut out = Vec::with_capacity(PARTICLES);
     for iz in 0.. {
-        let shift_y = if iz % 2 == 1 { spacing / (2.0 * 3f64.sqrt()) } else { 0.0 };
+        let shift_y = if iz % 2 == 1 {
+            spacing / (2.0 * 3f64.sqrt())
+        } else {
+            0.0
+        };
         for iy in 0.. {
             let y = RADIUS_M + iy as f64 * row + shift_y;
             if y > SIDE_M - RADIUS_M {
@@ -72,7 +76,10 @@ fn lists(c: &mut Criterion) {
         candidates.build(&outer, &team);
         let mut list = NeighborList::default();
         list.refilter(&candidates, &inner, &team);
-        assert!(list.pair_count() > 5 * PARTICLES, "a dense packing has about six pairs per sphere");
+        assert!(
+            list.pair_count() > 5 * PARTICLES,
+            "a dense packing has about six pairs per sphere"
+        );
         c.bench_function(&format!("neighbor/cell_search/{threads}_thread"), |b| {
             b.iter(|| candidates.build(&outer, &team))
         });
