@@ -22,6 +22,8 @@ pub struct DemBenchOptions {
     pub liggghts: bool,
     /// Also run one thread, interleaved with the `threads` run (see [`run_interleaved`]).
     pub speedup: bool,
+    /// As `speedup`, and also measure the machine's ceiling for it (see [`run_interleaved`]).
+    pub ceiling: bool,
     pub liggghts_input: Option<PathBuf>,
     pub liggghts_binary: PathBuf,
 }
@@ -92,29 +94,68 @@ fn bench_simulation(threads: usize) -> Result<Simulation> {
 /// Steps per turn of [`run_interleaved`].
 const INTERLEAVE_STEPS: u64 = 1000;
 
+/// What [`run_interleaved`] measured.
+pub struct Interleaved {
+    /// The `threads` run.
+    pub many: RunFigures,
+    /// The one-thread run.
+    pub one: RunFigures,
+    /// The `threads` simulation at the end.
+    pub sim: Simulation,
+    /// The first difference between the `threads` run's and the one-thread run's final states (`None`:
+    /// bit-identical, as the engine guarantees for any thread count).
+    pub difference: Option<String>,
+    /// With `ceiling`: the machine's own ceiling for the speed-up (see [`run_interleaved`]).
+    pub ceiling: Option<Ceiling>,
+}
+
+/// `threads` independent one-thread runs of the benchmark, one after another and side by side.
+pub struct Ceiling {
+    /// Time of the runs one after another over time of the same runs side by side.
+    pub speedup: f64,
+    /// The first difference between a side-by-side run's final state and the one-thread run's (`None`: identical).
+    pub difference: Option<String>,
+}
+
 /// Runs the benchmark on `threads` threads and on one thread in turns of [`INTERLEAVE_STEPS`] steps (the order
-/// alternating from turn to turn), timing each run's turns only. A machine whose speed drifts during the benchmark
+/// rotating from turn to turn), timing each run's turns only. A machine whose speed drifts during the benchmark
 /// (a shared virtual machine's does, by 10 % and more between runs a minute apart) then slows both runs alike,
-/// and their ratio measures the parallel speed-up rather than the drift. Returns the two runs' figures
-/// (`threads` first), the `threads` simulation, and the first difference between the two final states (`None`:
-/// bit-identical, as the engine guarantees for any thread count).
-pub fn run_interleaved(threads: usize, steps: u64) -> Result<(RunFigures, RunFigures, Simulation, Option<String>)> {
+/// and their ratio measures the parallel speed-up rather than the drift.
+///
+/// With `ceiling`, two more contestants take their turns: `threads` independent one-thread simulations of the same
+/// problem run one after another, and another `threads` run side by side, each on its own thread with nothing
+/// shared. Their time ratio is the most any division of this work into `threads` parts could gain on this machine:
+/// where the virtual machine's cores share a physical core's execution units, or the host runs other work beside
+/// them, it falls short of `threads`.
+pub fn run_interleaved(threads: usize, steps: u64, ceiling: bool) -> Result<Interleaved> {
     let mut many = bench_simulation(threads)?;
     let mut one = bench_simulation(1)?;
+    let copies = if ceiling { threads } else { 0 };
+    let mut after_another = (0..copies).map(|_| bench_simulation(1)).collect::<Result<Vec<_>>>()?;
+    let mut side_by_side = (0..copies).map(|_| bench_simulation(1)).collect::<Result<Vec<_>>>()?;
     let mut samples = vec![sample(&many)];
-    let (mut many_s, mut one_s) = (0.0, 0.0);
+    let contestants = if ceiling { 4 } else { 2 };
+    let mut time_s = [0.0f64; 4];
     let mut turn = 0u64;
     while many.step < steps {
         let chunk = (INTERLEAVE_STEPS - many.step % INTERLEAVE_STEPS).min(steps - many.step);
-        for which in [turn % 2, 1 - turn % 2] {
+        for k in 0..contestants {
+            let which = (turn as usize + k) % contestants;
             let start = Instant::now();
-            if which == 0 {
-                many.run_steps(chunk)?;
-                many_s += start.elapsed().as_secs_f64();
-            } else {
-                one.run_steps(chunk)?;
-                one_s += start.elapsed().as_secs_f64();
+            match which {
+                0 => many.run_steps(chunk)?,
+                1 => one.run_steps(chunk)?,
+                2 => after_another.iter_mut().try_for_each(|s| s.run_steps(chunk))?,
+                _ => std::thread::scope(|scope| {
+                    let runs: Vec<_> = side_by_side
+                        .iter_mut()
+                        .map(|s| scope.spawn(move || s.run_steps(chunk)))
+                        .collect();
+                    runs.into_iter()
+                        .try_for_each(|r| r.join().expect("a side-by-side benchmark run panicked"))
+                })?,
             }
+            time_s[which] += start.elapsed().as_secs_f64();
         }
         turn += 1;
         if many.step % SAMPLE_EVERY == 0 || many.step == steps {
@@ -122,23 +163,27 @@ pub fn run_interleaved(threads: usize, steps: u64) -> Result<(RunFigures, RunFig
         }
     }
     let particles = many.particles.len();
-    let difference = crate::engine::state::first_difference(&many.snapshot(), &one.snapshot());
-    Ok((
-        RunFigures {
-            particles,
-            steps,
-            loop_time_s: many_s,
-            samples,
-        },
-        RunFigures {
-            particles,
-            steps,
-            loop_time_s: one_s,
-            samples: Vec::new(),
-        },
-        many,
+    let one_state = one.snapshot();
+    let difference = crate::engine::state::first_difference(&many.snapshot(), &one_state);
+    let ceiling = ceiling.then(|| Ceiling {
+        speedup: time_s[2] / time_s[3],
+        difference: side_by_side
+            .iter()
+            .find_map(|s| crate::engine::state::first_difference(&s.snapshot(), &one_state)),
+    });
+    let figures = |loop_time_s: f64, samples: Vec<PhysicsSample>| RunFigures {
+        particles,
+        steps,
+        loop_time_s,
+        samples,
+    };
+    Ok(Interleaved {
+        many: figures(time_s[0], samples),
+        one: figures(time_s[1], Vec::new()),
+        sim: many,
         difference,
-    ))
+        ceiling,
+    })
 }
 
 /// Runs granflow on the benchmark problem.
@@ -288,12 +333,12 @@ fn rel(a: f64, b: f64) -> f64 {
 
 /// Runs the benchmark and prints its report; the last line is `ratio_vs_liggghts: <x>` when LIGGGHTS ran.
 pub fn bench_dem(opts: &DemBenchOptions) -> Result<()> {
-    let (ours, sim, one_thread) = if opts.speedup && opts.threads > 1 {
-        let (ours, one, sim, difference) = run_interleaved(opts.threads, opts.steps)?;
-        (ours, sim, Some((one, difference)))
+    let (ours, sim, one_thread, ceiling) = if (opts.speedup || opts.ceiling) && opts.threads > 1 {
+        let run = run_interleaved(opts.threads, opts.steps, opts.ceiling)?;
+        (run.many, run.sim, Some((run.one, run.difference)), run.ceiling)
     } else {
         let (ours, sim) = run_granflow(opts.threads, opts.steps)?;
-        (ours, sim, None)
+        (ours, sim, None, None)
     };
     let heap = sim.heap_bytes();
     println!(
@@ -316,12 +361,31 @@ pub fn bench_dem(opts: &DemBenchOptions) -> Result<()> {
                 Some(d) => format!("DIFFER: {d}"),
             }
         );
-        println!("speedup_vs_1_thread: {:.3}", one.loop_time_s / ours.loop_time_s);
+        let speedup = one.loop_time_s / ours.loop_time_s;
+        println!("speedup_vs_1_thread: {speedup:.3}");
         if let Some(d) = difference {
             return Err(Error::External(format!(
                 "the {}-thread and 1-thread runs ended in different states ({d})",
                 opts.threads
             )));
+        }
+        if let Some(c) = &ceiling {
+            println!(
+                "granflow: {n} independent 1-thread runs of the same problem, interleaved with the above: side by side on {n} threads {:.3} times as fast as one after another; final states {}",
+                c.speedup,
+                match &c.difference {
+                    None => "bit-identical to the 1-thread run's".to_string(),
+                    Some(d) => format!("DIFFER: {d}"),
+                },
+                n = opts.threads
+            );
+            println!("ceiling_independent_runs: {:.3}", c.speedup);
+            println!("speedup_share_of_ceiling: {:.3}", speedup / c.speedup);
+            if let Some(d) = &c.difference {
+                return Err(Error::External(format!(
+                    "a side-by-side 1-thread run ended in a different state ({d})"
+                )));
+            }
         }
     }
     let (pair_contacts, wall_contacts) = sim.contact_counts();
@@ -412,5 +476,21 @@ mod tests {
         assert_eq!(f.samples.len(), 2);
         assert_eq!(f.samples[1].kinetic_energy_j, 0.0621384);
         assert_eq!(mem, Some(18.4905));
+    }
+
+    #[test]
+    fn interleaved_runs_with_the_ceiling_all_end_in_the_one_thread_state() {
+        // Past the first turn, so that every contestant runs in two turns and the order rotates.
+        let run = run_interleaved(2, INTERLEAVE_STEPS + 150, true).expect("the benchmark runs");
+        assert_eq!(run.difference, None);
+        assert_eq!(run.sim.step, INTERLEAVE_STEPS + 150);
+        assert_eq!(run.sim.threads(), 2);
+        let ceiling = run.ceiling.expect("asked for");
+        assert_eq!(ceiling.difference, None);
+        for ratio in [ceiling.speedup, run.one.loop_time_s / run.many.loop_time_s] {
+            assert!(ratio.is_finite() && ratio > 0.0, "ratio {ratio}");
+        }
+        assert_eq!(run.many.samples.first().map(|s| s.step), Some(0));
+        assert_eq!(run.many.samples.last().map(|s| s.step), Some(INTERLEAVE_STEPS + 150));
     }
 }

@@ -170,6 +170,11 @@ pub enum BenchCommand {
         /// 1000 steps so that both see the same machine, and print `speedup_vs_1_thread: <x>`.
         #[arg(long)]
         speedup: bool,
+        /// As --speedup, and also run N independent one-thread copies of the problem side by side and one after
+        /// another, interleaved with the rest, printing `ceiling_independent_runs: <x>` (the most that dividing the
+        /// work could gain on this machine) and `speedup_share_of_ceiling: <speedup / ceiling>`.
+        #[arg(long)]
+        ceiling: bool,
         /// The LIGGGHTS input (default: ../shared/bench/liggghts/in.settle, searched upwards from here).
         #[arg(long)]
         liggghts_input: Option<PathBuf>,
@@ -253,6 +258,7 @@ pub fn run(cli: Cli) -> Result<i32> {
                     steps,
                     liggghts,
                     speedup,
+                    ceiling,
                     liggghts_input,
                     liggghts_binary,
                 },
@@ -261,6 +267,7 @@ pub fn run(cli: Cli) -> Result<i32> {
             steps,
             liggghts,
             speedup,
+            ceiling,
             liggghts_input,
             liggghts_binary,
         })
