@@ -47,6 +47,22 @@ const CASES: &[(&str, &str, &str, &[&str])] = &[
         &["bad.yaml", "neighbor.inner_skin_m", "<= neighbor.skin_m"],
     ),
     (
+        "a spinning particle that cannot rotate",
+        "fill:\n  - lattice: { species: glass, spacing_m: 0.0025, lo_m: [0.001, 0.001, 0.001], hi_m: [0.019, 0.019, 0.02] }",
+        "rotation: false\nfill:\n  - explicit: { species: glass, positions_m: [[0.01, 0.01, 0.01]], angular_velocities_rad_per_s: [[0.0, 5.0, 0.0]] }",
+        &[
+            "bad.yaml",
+            "fill[0].explicit.angular_velocities_rad_per_s[0]",
+            "rotation: false",
+        ],
+    ),
+    (
+        "rotation not a boolean",
+        "name: ok",
+        "name: ok\nrotation: sometimes",
+        &["bad.yaml:", "rotation"],
+    ),
+    (
         "negative radius",
         "radius_m: 0.001",
         "radius_m: -0.001",

@@ -209,6 +209,52 @@ fn a4_walton_braun_sliding_saturates_at_coulomb_limit() {
     assert!((w_end * r - v_end).abs() / v_end < 0.01, "rolls without slip");
 }
 
+/// A4 (c): with `rotation: false` nothing rolls: the same sphere launched along the floor decelerates at μg until it
+/// stops, at t = v0/(μg) after sliding v0²/(2μg), instead of rolling on at 5/7 v0; its angular velocity stays zero.
+#[test]
+fn a4_a_sphere_that_does_not_rotate_slides_to_rest() {
+    let (v0, mu, g, r): (f64, f64, f64, f64) = (0.05, 0.3, 9.81, 0.001);
+    let m = 2500.0 * 4.0 / 3.0 * PI * r.powi(3);
+    let e_pair = 1.0 / (2.0 * (1.0 - 0.3f64 * 0.3) / 1.0e8);
+    let kn = 4.0 / 3.0 * e_pair * r.sqrt();
+    let delta = (m * g / kn).powf(2.0 / 3.0);
+    let yaml =
+        sliding_sphere_yaml(v0, 0.0, mu, g, r - delta, 0.0).replace("name: slide\n", "name: slide\nrotation: false\n");
+    assert!(yaml.contains("rotation: false"));
+    let b = built(&yaml);
+    let mut sim = simulation(&b, 1);
+    let dt = b.dt_s;
+    let t_stop = v0 / (mu * g);
+    let mut t = 0.0;
+    let mut worst_rel = 0.0f64;
+    let mut step = 0;
+    while t < 0.8 * t_stop {
+        let vx0 = sim.particles.velocity_m_per_s[0].x;
+        sim.step().expect("stable");
+        t += dt;
+        step += 1;
+        let decel = (vx0 - sim.particles.velocity_m_per_s[0].x) / dt;
+        if step > 200 {
+            worst_rel = worst_rel.max((decel - mu * g).abs() / (mu * g));
+        }
+    }
+    println!("A4c: worst relative deviation of the sliding deceleration from μg: {worst_rel:.3e}");
+    assert!(worst_rel < 2e-3, "sliding friction is not μF_n: {worst_rel}");
+    while t < 1.5 * t_stop {
+        sim.step().expect("stable");
+        t += dt;
+    }
+    let (x_end, v_end) = (sim.particles.position_m[0].x, sim.particles.velocity_m_per_s[0].x);
+    let slide = v0 * v0 / (2.0 * mu * g);
+    println!("A4c: slid {x_end:.6e} m (v0²/2μg = {slide:.6e}), final speed {v_end:.3e} m/s");
+    assert!(v_end.abs() < 1e-3 * v0, "still moving at {v_end} m/s");
+    assert!(
+        (x_end - slide).abs() / slide < 0.01,
+        "slid {x_end} m, expected {slide} m"
+    );
+    assert_eq!(sim.particles.angular_velocity_rad_per_s[0], Vec3::zeros());
+}
+
 /// A4 (b): an oblique, spinning impact on a wall conserves the angular momentum about the contact point,
 /// I ω + m R n × v (friction and the normal force both act at the contact).
 #[test]

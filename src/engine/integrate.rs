@@ -14,7 +14,8 @@ use super::team::Team;
 const CHUNK: usize = 2048;
 
 /// Inverse masses and moments of inertia, derived once from the particle arrays (never checkpointed: they follow
-/// from `mass_kg` and `inertia_kg_m2` exactly), so that each half kick multiplies instead of dividing.
+/// from `mass_kg` and `inertia_kg_m2` exactly), so that each half kick multiplies instead of dividing. Without
+/// rotation the inverse moments of inertia are zero: every torque then leaves the angular velocity as it is.
 #[derive(Debug, Clone, Default)]
 pub struct InverseInertia {
     pub inv_mass_per_kg: Vec<f64>,
@@ -22,10 +23,14 @@ pub struct InverseInertia {
 }
 
 impl InverseInertia {
-    pub fn new(p: &Particles) -> Self {
+    pub fn new(p: &Particles, rotation: bool) -> Self {
         InverseInertia {
             inv_mass_per_kg: p.mass_kg.iter().map(|m| 1.0 / m).collect(),
-            inv_inertia_per_kg_m2: p.inertia_kg_m2.iter().map(|i| 1.0 / i).collect(),
+            inv_inertia_per_kg_m2: p
+                .inertia_kg_m2
+                .iter()
+                .map(|i| if rotation { 1.0 / i } else { 0.0 })
+                .collect(),
         }
     }
 }

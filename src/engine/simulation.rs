@@ -38,6 +38,8 @@ pub struct SimConfig {
     /// One particle layer moving in x–y only (seeds' 2-D beds and kilns): z velocity, z force and x/y rotation are
     /// held at zero.
     pub pseudo_2d: bool,
+    /// Particles rotate; `false`: their angular velocities are never updated (inverse moments of inertia zero).
+    pub rotation: bool,
     pub gravity: Gravity,
     pub species: SpeciesTable,
     pub pair_table: PairTable,
@@ -141,7 +143,7 @@ impl Simulation {
         threads: usize,
     ) -> Result<Self, NumericalError> {
         let n_walls = config.walls.len();
-        let inverse = InverseInertia::new(&particles);
+        let inverse = InverseInertia::new(&particles, config.rotation);
         let mut sim = Simulation {
             config,
             particles,
@@ -179,7 +181,7 @@ impl Simulation {
 
     /// Resumes from a checkpointed state; the next `step()` continues exactly where the saved run was.
     pub fn restore(config: Arc<SimConfig>, state: SimState, threads: usize) -> Result<Self, NumericalError> {
-        let inverse = InverseInertia::new(&state.particles);
+        let inverse = InverseInertia::new(&state.particles, config.rotation);
         let mut sim = Simulation {
             config,
             particles: state.particles,

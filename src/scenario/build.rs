@@ -277,6 +277,7 @@ pub fn build(spec: ScenarioSpec, path: &Path) -> Result<BuiltScenario, ConfigErr
     let config = SimConfig {
         domain,
         pseudo_2d: spec.pseudo_2d,
+        rotation: spec.rotation,
         gravity: spec.gravity,
         species,
         pair_table,
@@ -732,6 +733,12 @@ fn fill(
                     }
                     if let Some(w) = angular_velocities_rad_per_s.get(n) {
                         c.finite3(&key(&format!("angular_velocities_rad_per_s[{n}]")), w)?;
+                        if !spec.rotation && w.iter().any(|&a| a != 0.0) {
+                            return Err(c.fail(
+                                key(&format!("angular_velocities_rad_per_s[{n}]")),
+                                "particles that do not rotate (`rotation: false`) cannot start spinning",
+                            ));
+                        }
                         particles.angular_velocity_rad_per_s[id.index()] = Vec3::from(*w);
                     }
                 }

@@ -17,6 +17,11 @@ pub struct ScenarioSpec {
     /// One particle layer, motion in x–y only.
     #[serde(default)]
     pub pseudo_2d: bool,
+    /// Whether particles rotate (default true). `false`: angular velocities are never updated, so friction resists
+    /// sliding only and nothing rolls, as LIGGGHTS's `fix nve` does instead of `fix nve/sphere` (seed 001 uses
+    /// rotation rates in its slip velocity, eq 6.23, but gives no rotation update).
+    #[serde(default = "rotation_default", skip_serializing_if = "rotates")]
+    pub rotation: bool,
     pub gravity: Gravity,
     pub species: Vec<Species>,
     pub contact: ContactLaw,
@@ -45,6 +50,14 @@ pub struct ScenarioSpec {
     /// no particle–sidewall or no particle–distributor cohesion); absent: none.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub cohesion_off: Option<CohesionOff>,
+}
+
+fn rotation_default() -> bool {
+    true
+}
+
+fn rotates(rotation: &bool) -> bool {
+    *rotation
 }
 
 /// What `cohesion_off` switches the cohesion model off for.
