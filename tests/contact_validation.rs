@@ -6,8 +6,8 @@ mod common;
 use std::f64::consts::PI;
 
 use common::{built, simulation};
-use granflow::engine::Vec3;
 use granflow::engine::models::normal::{thornton_restitution, thornton_yield_velocity};
+use granflow::engine::{Simulation, Vec3};
 
 /// Two equal spheres approaching head-on along x at relative speed `v_rel`; returns (contact duration, restitution).
 fn head_on(contact_yaml: &str, species_yaml: &str, radius: f64, v_rel: f64, dt: f64) -> (f64, f64) {
@@ -162,36 +162,43 @@ time: {{ dt_s: 2.0e-7, end_time_s: 1.0 }}
     )
 }
 
-/// A4 (a): Walton-Braun friction saturates at μF_n while sliding: a sphere launched along a floor decelerates at
-/// exactly μg until it rolls, and then rolls at 5/7 of its launch speed.
-#[test]
-fn a4_walton_braun_sliding_saturates_at_coulomb_limit() {
-    let (v0, mu, g, r): (f64, f64, f64, f64) = (0.05, 0.3, 9.81, 0.001);
-    // Start at the static overlap so the sphere does not bounce: m g = k_n δ^{3/2}.
+/// The centre height of `sliding_sphere_yaml`'s sphere resting at its static overlap on the floor, m g = k_n δ^{3/2},
+/// so that it starts without bouncing. Wall and particle are of the same material: 1/E* = 2 (1 − ν²)/E.
+fn resting_centre_height_m(r: f64, g: f64) -> f64 {
     let m = 2500.0 * 4.0 / 3.0 * PI * r.powi(3);
-    // Wall and particle of the same material: 1/E* = 2 (1 − ν²)/E.
     let e_pair = 1.0 / (2.0 * (1.0 - 0.3f64 * 0.3) / 1.0e8);
     let kn = 4.0 / 3.0 * e_pair * r.sqrt();
-    let delta = (m * g / kn).powf(2.0 / 3.0);
-    let b = built(&sliding_sphere_yaml(v0, 0.0, mu, g, r - delta, 0.0));
-    let mut sim = simulation(&b, 1);
-    let dt = b.dt_s;
-    let mut t = 0.0;
-    let mut worst_rel = 0.0f64;
-    // Sliding lasts t_s = 2 v0 / (7 μ g); check the deceleration over the first 80 % of it.
-    let t_slide = 2.0 * v0 / (7.0 * mu * g);
-    let check_from = 200; // after the micro-slip transient of the first steps
-    let mut step = 0;
-    while t < 0.8 * t_slide {
+    r - (m * g / kn).powf(2.0 / 3.0)
+}
+
+/// Steps a sphere sliding along x until `until_s`; returns the largest relative deviation of its deceleration from
+/// μg after the first 200 steps (the micro-slip transient), and the time reached.
+fn worst_sliding_deceleration(sim: &mut Simulation, dt: f64, until_s: f64, mu: f64, g: f64) -> (f64, f64) {
+    let (mut t, mut step, mut worst_rel) = (0.0, 0, 0.0f64);
+    while t < until_s {
         let vx0 = sim.particles.velocity_m_per_s[0].x;
         sim.step().expect("stable");
         t += dt;
         step += 1;
         let decel = (vx0 - sim.particles.velocity_m_per_s[0].x) / dt;
-        if step > check_from {
+        if step > 200 {
             worst_rel = worst_rel.max((decel - mu * g).abs() / (mu * g));
         }
     }
+    (worst_rel, t)
+}
+
+/// A4 (a): Walton-Braun friction saturates at μF_n while sliding: a sphere launched along a floor decelerates at
+/// exactly μg until it rolls, and then rolls at 5/7 of its launch speed.
+#[test]
+fn a4_walton_braun_sliding_saturates_at_coulomb_limit() {
+    let (v0, mu, g, r): (f64, f64, f64, f64) = (0.05, 0.3, 9.81, 0.001);
+    let b = built(&sliding_sphere_yaml(v0, 0.0, mu, g, resting_centre_height_m(r, g), 0.0));
+    let mut sim = simulation(&b, 1);
+    let dt = b.dt_s;
+    // Sliding lasts t_s = 2 v0 / (7 μ g); check the deceleration over the first 80 % of it.
+    let t_slide = 2.0 * v0 / (7.0 * mu * g);
+    let (worst_rel, mut t) = worst_sliding_deceleration(&mut sim, dt, 0.8 * t_slide, mu, g);
     println!("A4a: worst relative deviation of the sliding deceleration from μg: {worst_rel:.3e}");
     assert!(worst_rel < 2e-3, "sliding friction is not μF_n: {worst_rel}");
     while t < 2.0 * t_slide {
@@ -214,30 +221,14 @@ fn a4_walton_braun_sliding_saturates_at_coulomb_limit() {
 #[test]
 fn a4_a_sphere_that_does_not_rotate_slides_to_rest() {
     let (v0, mu, g, r): (f64, f64, f64, f64) = (0.05, 0.3, 9.81, 0.001);
-    let m = 2500.0 * 4.0 / 3.0 * PI * r.powi(3);
-    let e_pair = 1.0 / (2.0 * (1.0 - 0.3f64 * 0.3) / 1.0e8);
-    let kn = 4.0 / 3.0 * e_pair * r.sqrt();
-    let delta = (m * g / kn).powf(2.0 / 3.0);
-    let yaml =
-        sliding_sphere_yaml(v0, 0.0, mu, g, r - delta, 0.0).replace("name: slide\n", "name: slide\nrotation: false\n");
+    let yaml = sliding_sphere_yaml(v0, 0.0, mu, g, resting_centre_height_m(r, g), 0.0)
+        .replace("name: slide\n", "name: slide\nrotation: false\n");
     assert!(yaml.contains("rotation: false"));
     let b = built(&yaml);
     let mut sim = simulation(&b, 1);
     let dt = b.dt_s;
     let t_stop = v0 / (mu * g);
-    let mut t = 0.0;
-    let mut worst_rel = 0.0f64;
-    let mut step = 0;
-    while t < 0.8 * t_stop {
-        let vx0 = sim.particles.velocity_m_per_s[0].x;
-        sim.step().expect("stable");
-        t += dt;
-        step += 1;
-        let decel = (vx0 - sim.particles.velocity_m_per_s[0].x) / dt;
-        if step > 200 {
-            worst_rel = worst_rel.max((decel - mu * g).abs() / (mu * g));
-        }
-    }
+    let (worst_rel, mut t) = worst_sliding_deceleration(&mut sim, dt, 0.8 * t_stop, mu, g);
     println!("A4c: worst relative deviation of the sliding deceleration from μg: {worst_rel:.3e}");
     assert!(worst_rel < 2e-3, "sliding friction is not μF_n: {worst_rel}");
     while t < 1.5 * t_stop {
