@@ -124,9 +124,10 @@ pub struct Ceiling {
 ///
 /// With `ceiling`, two more contestants take their turns: `threads` independent one-thread simulations of the same
 /// problem run one after another, and another `threads` run side by side, each on its own thread with nothing
-/// shared. Their time ratio is the most any division of this work into `threads` parts could gain on this machine:
-/// where the virtual machine's cores share a physical core's execution units, or the host runs other work beside
-/// them, it falls short of `threads`.
+/// shared. Their time ratio is what this machine gives `threads` busy threads on this work: where the virtual
+/// machine's cores share a physical core's execution units, or the host runs other work beside them, it falls short
+/// of `threads`. It is a reference rather than a strict bound on a divided run: the copies hold `threads` times the
+/// data, so a run that divides one copy can come out a little above it.
 pub fn run_interleaved(threads: usize, steps: u64, ceiling: bool) -> Result<Interleaved> {
     let mut many = bench_simulation(threads)?;
     let mut one = bench_simulation(1)?;
