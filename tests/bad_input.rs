@@ -1,5 +1,6 @@
-//! Bad scenario input through the real binary: one clear message naming the file and the line/column or key path,
-//! exit code 2, and nothing written. (The campaign issue extends this table to campaign files.)
+//! Bad scenario input through the real binary: one clear message naming the file, the line and column of the
+//! edit, and for a value that parses but is not valid its key path; exit code 2, and nothing written.
+//! (`tests/campaign_bad_input.rs` does the same for campaign files.)
 
 mod common;
 
@@ -21,7 +22,12 @@ time: { dt_s: 1.0e-5, end_time_s: 0.001 }
 
 /// (case, text replaced in GOOD, replacement, fragments the message must contain)
 const CASES: &[(&str, &str, &str, &[&str])] = &[
-    ("yaml syntax error", "gravity: {", "gravity: {{", &["bad.yaml:", "line"]),
+    (
+        "yaml syntax error",
+        "gravity: {",
+        "gravity: {{",
+        &["bad.yaml:4:11:", "invalid type"],
+    ),
     (
         "unknown key",
         "radius_m: 0.001",
@@ -211,6 +217,17 @@ fn bad_scenarios_fail_cleanly_before_writing_anything() {
         for f in *fragments {
             assert!(stderr.contains(f), "case '{case}': message lacks '{f}': {stderr}");
         }
+        // Every message names the line of the edit (or, for an edit of several lines, one of them).
+        let first_line = GOOD[..GOOD.find(from).expect("checked above")].matches('\n').count() + 1;
+        let lines = first_line..=first_line + to.lines().count().max(1) - 1;
+        let line: Option<usize> = stderr
+            .strip_prefix("error: bad.yaml:")
+            .and_then(|rest| rest.split(':').next())
+            .and_then(|l| l.parse().ok());
+        assert!(
+            line.is_some_and(|l| lines.contains(&l)),
+            "case '{case}': expected `error: bad.yaml:<line>:` with a line in {lines:?}: {stderr}"
+        );
         assert_eq!(stderr.lines().count(), 1, "case '{case}': one message: {stderr}");
         assert!(!dir.join("bad-out").exists(), "case '{case}': wrote output");
     }

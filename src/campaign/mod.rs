@@ -54,11 +54,7 @@ impl Campaign {
 }
 
 fn invalid(path: &Path, key: impl Into<String>, message: impl Into<String>) -> ConfigError {
-    ConfigError::Invalid {
-        path: path.to_path_buf(),
-        key: key.into(),
-        message: message.into(),
-    }
+    ConfigError::invalid(path, key, message)
 }
 
 /// Reads and expands a campaign file. Jobs are resolved but not yet validated as scenarios (see [`validate_jobs`]).
@@ -73,6 +69,49 @@ pub fn load(path: &Path) -> Result<Campaign, ConfigError> {
 /// As [`load`], from text (`path` is used in messages).
 pub fn from_yaml(yaml: &str, path: &Path) -> Result<Campaign, ConfigError> {
     let spec: CampaignSpec = scenario::parse_yaml(yaml, path)?;
+    let param_keys = first_param_keys(&spec);
+    expand(spec, yaml, path, &param_keys).map_err(|e| located(e, yaml, &param_keys))
+}
+
+/// Each swept parameter path → the key in the campaign file that sets it first (`sweep.grid[0].param`).
+fn first_param_keys(spec: &CampaignSpec) -> HashMap<String, String> {
+    let mut param_keys: HashMap<String, String> = HashMap::new();
+    for (param, key) in sweep::param_keys(&spec.sweep, "sweep") {
+        param_keys.entry(param).or_insert(key);
+    }
+    param_keys
+}
+
+/// Gives an error about the campaign file the line that writes the failing value: for a key of `base` that a sweep
+/// parameter sets (the key is that parameter or lies inside it), the parameter's entry in `sweep`; otherwise the
+/// key itself, or its nearest parent written in the file.
+fn located(e: ConfigError, yaml: &str, param_keys: &HashMap<String, String>) -> ConfigError {
+    let ConfigError::Invalid { key, .. } = &e else {
+        return e;
+    };
+    let inside = |k: &str, p: &str| {
+        k.strip_prefix(p)
+            .is_some_and(|r| r.is_empty() || r.starts_with(['.', '[']))
+    };
+    let written = key
+        .strip_prefix("base.")
+        .and_then(|k| {
+            param_keys
+                .iter()
+                .filter(|(p, _)| inside(k, p))
+                .max_by(|a, b| a.0.len().cmp(&b.0.len()).then_with(|| b.0.cmp(a.0)))
+        })
+        .map_or_else(|| key.clone(), |(_, sweep_key)| sweep_key.clone());
+    e.at(yaml, &written)
+}
+
+/// The checks and the sweep expansion of [`from_yaml`], after the text has parsed.
+fn expand(
+    spec: CampaignSpec,
+    yaml: &str,
+    path: &Path,
+    param_keys: &HashMap<String, String>,
+) -> Result<Campaign, ConfigError> {
     check_finite(yaml).map_err(|(key, m)| invalid(path, key, m))?;
     check_name(&spec.name).map_err(|m| invalid(path, "name", m))?;
     metrics::check(&spec).map_err(|(key, m)| invalid(path, key, m))?;
@@ -167,14 +206,10 @@ pub fn from_yaml(yaml: &str, path: &Path) -> Result<Campaign, ConfigError> {
         ));
     }
     let base = base_document(&spec);
-    let mut param_keys: HashMap<String, String> = HashMap::new();
-    for (param, key) in sweep::param_keys(&spec.sweep, "sweep") {
-        param_keys.entry(param).or_insert(key);
-    }
     let mut jobs = Vec::with_capacity(points.len());
     let mut seen: HashMap<String, usize> = HashMap::new();
     for (ordinal, point) in points.into_iter().enumerate() {
-        let job = resolve(&spec, &base, point, ordinal, &param_keys, path)?;
+        let job = resolve(&spec, &base, point, ordinal, param_keys, path)?;
         if let Some(&first) = seen.get(&job.job_id) {
             return Err(invalid(
                 path,
@@ -362,9 +397,18 @@ fn describe(point: &sweep::Point) -> String {
         .join(", ")
 }
 
-/// Validates every given job as a scenario (geometry, materials, particles fitting), naming the sweep point of the
-/// first that fails. Builds the particles, so it costs what building the jobs costs.
-pub fn validate_jobs<'a>(jobs: impl IntoIterator<Item = &'a JobSpec>, path: &Path) -> Result<(), ConfigError> {
+/// Validates every given job of `campaign` as a scenario (geometry, materials, particles fitting), naming the sweep
+/// point of the first that fails and the line of `path`, the campaign's file, that sets the value. Builds the
+/// particles, so it costs what building the jobs costs.
+pub fn validate_jobs<'a>(
+    campaign: &Campaign,
+    jobs: impl IntoIterator<Item = &'a JobSpec>,
+    path: &Path,
+) -> Result<(), ConfigError> {
+    validate_each(jobs, path).map_err(|e| located(e, &campaign.yaml, &first_param_keys(&campaign.spec)))
+}
+
+fn validate_each<'a>(jobs: impl IntoIterator<Item = &'a JobSpec>, path: &Path) -> Result<(), ConfigError> {
     for job in jobs {
         if let Err(e) = scenario::build(job.scenario.clone(), path) {
             let point = describe(&job.params);

@@ -81,9 +81,9 @@ pub fn run_campaign(campaign: &Campaign, source: &Path, out: &Path, opts: &Dispa
         .iter()
         .filter(|j| !job_dir(out, &j.job_id).join("result.json").exists())
         .collect();
-    campaign::validate_jobs(unfinished.iter().copied(), source)?;
+    campaign::validate_jobs(campaign, unfinished.iter().copied(), source)?;
     if !opts.force {
-        check_no_orphans(campaign, out)?;
+        check_no_orphans(campaign, source, out)?;
     }
 
     std::fs::create_dir_all(out.join("jobs")).map_err(|e| Error::io("create directory", out, e))?;
@@ -234,7 +234,7 @@ pub fn store_derived(
 
 /// Refuses a campaign file that no longer produces jobs the directory's database holds: their parameters changed,
 /// and running would silently leave them behind.
-fn check_no_orphans(campaign: &Campaign, out: &Path) -> Result<(), Error> {
+fn check_no_orphans(campaign: &Campaign, source: &Path, out: &Path) -> Result<(), Error> {
     let db = database_path(out);
     if !db.exists() {
         return Ok(());
@@ -254,17 +254,20 @@ fn check_no_orphans(campaign: &Campaign, out: &Path) -> Result<(), Error> {
     if orphans.is_empty() {
         return Ok(());
     }
-    Err(Error::Config(crate::scenario::ConfigError::Invalid {
-        path: spec_copy_path(out),
-        key: "sweep".into(),
-        message: format!(
-            "{} job(s) already in {} are not produced by this campaign file any more (changed parameters make \
+    Err(Error::Config(
+        crate::scenario::ConfigError::invalid(
+            source,
+            "sweep",
+            format!(
+                "{} job(s) already in {} are not produced by this campaign file any more (changed parameters make \
              new jobs), e.g. {}; use another --out, or --force to run anyway and keep the old jobs' results",
-            orphans.len(),
-            out.display(),
-            orphans[0]
-        ),
-    }))
+                orphans.len(),
+                out.display(),
+                orphans[0]
+            ),
+        )
+        .located(&campaign.yaml),
+    ))
 }
 
 /// A sweep value as stored in the `params` table: numbers as reals, anything else as its JSON text (strings

@@ -4,7 +4,7 @@
 //! Non-SI inputs (rpm, degrees) are converted here and nowhere else.
 
 use std::f64::consts::PI;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::sync::Arc;
 
 use rand::RngExt;
@@ -39,11 +39,7 @@ struct Checker<'a> {
 
 impl Checker<'_> {
     fn fail(&self, key: impl Into<String>, message: impl Into<String>) -> ConfigError {
-        ConfigError::Invalid {
-            path: PathBuf::from(self.path),
-            key: key.into(),
-            message: message.into(),
-        }
+        ConfigError::invalid(self.path, key, message)
     }
 
     fn positive(&self, key: &str, v: f64) -> Result<(), ConfigError> {

@@ -3,6 +3,7 @@
 
 mod build;
 pub mod gas;
+mod locate;
 pub mod spec;
 
 use std::path::{Path, PathBuf};
@@ -26,12 +27,56 @@ pub enum ConfigError {
         column: usize,
         message: String,
     },
-    #[error("{}: key `{key}`: {message}", path.display())]
+    #[error("{}{}: key `{key}`: {message}", path.display(), at.map_or(String::new(), |(l, c)| format!(":{l}:{c}")))]
     Invalid {
         path: PathBuf,
+        /// Line and column (1-based) of the value in the file, where it is written there (see [`ConfigError::at`]).
+        at: Option<(usize, usize)>,
         key: String,
         message: String,
     },
+}
+
+impl ConfigError {
+    /// A value that is not valid, at `key` of the file `path` (located later by [`ConfigError::at`]).
+    pub fn invalid(path: &Path, key: impl Into<String>, message: impl Into<String>) -> Self {
+        ConfigError::Invalid {
+            path: path.to_path_buf(),
+            at: None,
+            key: key.into(),
+            message: message.into(),
+        }
+    }
+
+    /// Gives an [`ConfigError::Invalid`] the line and column where `yaml`, the text of its file, writes the value
+    /// at `written_key` (or its nearest written parent). Other errors are returned as they are.
+    pub fn at(self, yaml: &str, written_key: &str) -> Self {
+        match self {
+            ConfigError::Invalid {
+                path,
+                at: None,
+                key,
+                message,
+            } => ConfigError::Invalid {
+                path,
+                at: locate::locate(yaml, written_key),
+                key,
+                message,
+            },
+            other => other,
+        }
+    }
+
+    /// As [`ConfigError::at`], with the error's own key as the written one.
+    pub fn located(self, yaml: &str) -> Self {
+        match &self {
+            ConfigError::Invalid { key, .. } => {
+                let key = key.clone();
+                self.at(yaml, &key)
+            }
+            _ => self,
+        }
+    }
 }
 
 /// Parses scenario YAML text; `path` is used in messages only.
@@ -47,13 +92,30 @@ pub fn parse_yaml<T: serde::de::DeserializeOwned>(text: &str, path: &Path) -> Re
     let de = serde_norway::Deserializer::from_str(text);
     serde_norway::with::singleton_map_recursive::deserialize(de).map_err(|e: serde_norway::Error| {
         let (line, column) = e.location().map_or((0, 0), |l| (l.line(), l.column()));
+        // The location leads the message already (`file:line:column:`), so serde_norway's own copy of it goes.
+        let message = e
+            .to_string()
+            .replacen(&format!(" at line {line} column {column}"), "", 1);
         ConfigError::Yaml {
             path: path.to_path_buf(),
             line,
             column,
-            message: with_suggestion(e.to_string()),
+            message: with_suggestion(plain_expectation(message)),
         }
     })
+}
+
+/// Says "expected a mapping of keys" where serde names the Rust type it wanted (`expected struct ScenarioSpec`).
+fn plain_expectation(message: String) -> String {
+    const STRUCT: &str = "expected struct ";
+    let Some(i) = message.find(STRUCT) else {
+        return message;
+    };
+    let rest = &message[i + STRUCT.len()..];
+    let end = rest
+        .find(|c: char| !(c.is_alphanumeric() || c == '_'))
+        .unwrap_or(rest.len());
+    format!("{}expected a mapping of keys{}", &message[..i], &rest[end..])
 }
 
 /// Appends "did you mean `x`?" to serde's "unknown field `y`, expected one of `a`, `b`" (or "unknown variant")
@@ -83,5 +145,5 @@ pub fn load(path: &Path) -> Result<BuiltScenario, ConfigError> {
         path: path.to_path_buf(),
         source,
     })?;
-    build(parse(&text, path)?, path)
+    build(parse(&text, path)?, path).map_err(|e| e.located(&text))
 }
