@@ -245,10 +245,10 @@ pub fn run(cli: Cli) -> Result<i32> {
                 max_steps,
                 quiet,
             })?;
-            println!(
-                "{}",
+            emit(&format!(
+                "{}\n",
                 serde_json::to_string_pretty(&summary).expect("summary serialises")
-            );
+            ))?;
             Ok(0)
         }
         Command::Bench {
@@ -277,14 +277,14 @@ pub fn run(cli: Cli) -> Result<i32> {
         } => crate::bench_campaign::bench_campaign(&crate::bench_campaign::CampaignBenchOptions { jobs, max_parallel })
             .map(|()| 0),
         Command::Schema => {
-            println!(
-                "{}",
+            emit(&format!(
+                "{}\n",
                 serde_json::to_string_pretty(&crate::campaign::json_schema()).expect("a schema serialises")
-            );
+            ))?;
             Ok(0)
         }
         Command::Models => {
-            print!("{}", crate::models_doc::MODELS);
+            emit(crate::models_doc::MODELS)?;
             Ok(0)
         }
         Command::CohesionMap {
@@ -318,8 +318,10 @@ pub fn run(cli: Cli) -> Result<i32> {
                     cutoff_m: hamaker_cutoff_m,
                 },
             };
-            println!("particle mass {mass:.6e} kg, contact restitution {restitution:.5}, H_cut {hamaker_cutoff_m:e} m");
-            println!("well_depth_j,escape_velocity_m_per_s,hamaker_constant_j");
+            let mut text = format!(
+                "particle mass {mass:.6e} kg, contact restitution {restitution:.5}, H_cut {hamaker_cutoff_m:e} m\n\
+                 well_depth_j,escape_velocity_m_per_s,hamaker_constant_j\n"
+            );
             for depth_j in well_depth_j {
                 let well = SquareWell {
                     depth_j,
@@ -327,8 +329,9 @@ pub fn run(cli: Cli) -> Result<i32> {
                 };
                 let v = well.escape_velocity_m_per_s(mass, restitution);
                 let a = collision.hamaker_constant_for_escape_velocity_j(v, 1e-5);
-                println!("{depth_j:e},{v:.6e},{a:.6e}");
+                text.push_str(&format!("{depth_j:e},{v:.6e},{a:.6e}\n"));
             }
+            emit(&text)?;
             Ok(0)
         }
         Command::Run {
@@ -347,7 +350,7 @@ pub fn run(cli: Cli) -> Result<i32> {
             dispatch_campaign(&loaded, &source, &dir, dispatch, false)
         }
         Command::Status { dir } => {
-            print!("{}", inspect::status(&dir)?);
+            emit(&inspect::status(&dir)?)?;
             Ok(0)
         }
         Command::Query {
@@ -374,11 +377,11 @@ pub fn run(cli: Cli) -> Result<i32> {
                     ));
                 }
             };
-            print!("{text}");
+            emit(&text)?;
             Ok(0)
         }
         Command::Export { dir, format } => {
-            print!("{}", inspect::export(&dir, format)?);
+            emit(&inspect::export(&dir, format)?)?;
             Ok(0)
         }
         Command::Reduce { dir } => {
@@ -397,7 +400,7 @@ pub fn run(cli: Cli) -> Result<i32> {
                     crate::simulate::write_atomic(&path, text.as_bytes())?;
                     eprintln!("{}: {}", path.display(), text.lines().last().unwrap_or_default());
                 }
-                None => print!("{text}"),
+                None => emit(&text)?,
             }
             // A failed validation is a result, not an error: exit 0, the verdict says it.
             let _ = pass;
@@ -416,5 +419,18 @@ pub fn run(cli: Cli) -> Result<i32> {
             watch_stdin,
             max_steps,
         })),
+    }
+}
+
+/// Writes a command's output to standard output. A reader that stops early (`granflow schema | head -1`) is not an
+/// error: the rest is dropped, as other Unix tools do.
+fn emit(text: &str) -> Result<(), crate::Error> {
+    use std::io::Write;
+    let mut out = std::io::stdout().lock();
+    match out.write_all(text.as_bytes()).and_then(|()| out.flush()) {
+        Err(e) if e.kind() != std::io::ErrorKind::BrokenPipe => {
+            Err(crate::Error::io("write", std::path::Path::new("standard output"), e))
+        }
+        _ => Ok(()),
     }
 }

@@ -102,3 +102,31 @@ metrics: [kinetic_energy_j]
         "{message}"
     );
 }
+
+/// `granflow schema | head -1`: a reader that closes the pipe early ends the command quietly (exit 0, no panic),
+/// as it would any Unix tool. The schema is larger than a pipe's buffer, so the write does meet the closed pipe.
+#[test]
+fn schema_into_a_reader_that_stops_early_exits_quietly() {
+    use std::io::Read;
+    use std::process::{Command, Stdio};
+    let schema_len = serde_json::to_string_pretty(&granflow::campaign::json_schema())
+        .unwrap()
+        .len();
+    assert!(
+        schema_len > 1 << 16,
+        "the schema ({schema_len} bytes) no longer fills a pipe's buffer"
+    );
+    let mut child = Command::new(env!("CARGO_BIN_EXE_granflow"))
+        .arg("schema")
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("the granflow binary runs");
+    let mut first = [0u8; 1];
+    child.stdout.take().unwrap().read_exact(&mut first).unwrap();
+    assert_eq!(&first, b"{");
+    let out = child.wait_with_output().unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "exit {:?}: {stderr}", out.status.code());
+    assert!(stderr.is_empty(), "stderr: {stderr}");
+}
