@@ -2,8 +2,8 @@
 //! with LIGGGHTS on its reference input in the same invocation, printing both throughputs, the physics of both
 //! (kinetic-energy history, final bed height) and the ratio.
 //!
-//! The problem is `scenarios/bench-settle.yaml` (compiled in). LIGGGHTS runs an exact copy of `in.settle` in a
-//! temporary directory with two thermo columns added (highest and mean particle height); nothing else changes.
+//! The problem is `scenarios/bench-settle.yaml` (compiled in). LIGGGHTS runs an exact copy of `in.settle`
+//! (`benches/liggghts/in.settle`, compiled in; `--liggghts-input` gives another) in a temporary directory with two thermo columns added (highest and mean particle height); nothing else changes.
 
 use std::path::{Path, PathBuf};
 use std::process::Command;
@@ -14,6 +14,9 @@ use crate::error::{Error, Result};
 use crate::scenario;
 
 pub const BENCH_SCENARIO: &str = include_str!("../scenarios/bench-settle.yaml");
+
+/// The LIGGGHTS reference input of the benchmark (a copy of `../shared/bench/liggghts/in.settle`, compiled in).
+pub const LIGGGHTS_INPUT: &str = include_str!("../benches/liggghts/in.settle");
 
 #[derive(Debug, Clone)]
 pub struct DemBenchOptions {
@@ -211,27 +214,9 @@ pub fn run_granflow(threads: usize, steps: u64) -> Result<(RunFigures, Simulatio
     ))
 }
 
-/// Finds `../shared/bench/liggghts/in.settle` from the working directory or its ancestors.
-fn find_liggghts_input() -> Option<PathBuf> {
-    let mut dir = std::env::current_dir().ok()?;
-    loop {
-        for candidate in [
-            dir.join("shared/bench/liggghts/in.settle"),
-            dir.join("../shared/bench/liggghts/in.settle"),
-        ] {
-            if candidate.is_file() {
-                return Some(candidate);
-            }
-        }
-        if !dir.pop() {
-            return None;
-        }
-    }
-}
-
-/// Runs LIGGGHTS on a copy of the reference input with height columns added to its thermo output.
-pub fn run_liggghts(binary: &Path, input: &Path, steps: u64) -> Result<(RunFigures, Option<f64>)> {
-    let text = std::fs::read_to_string(input).map_err(|e| Error::io("read", input, e))?;
+/// Runs LIGGGHTS on a copy of the reference input `text` (named `source` in messages) with height columns added to
+/// its thermo output.
+pub fn run_liggghts(binary: &Path, text: &str, source: &str, steps: u64) -> Result<(RunFigures, Option<f64>)> {
     let mut modified = String::new();
     let mut saw_thermo_style = false;
     for line in text.lines() {
@@ -247,10 +232,7 @@ pub fn run_liggghts(binary: &Path, input: &Path, steps: u64) -> Result<(RunFigur
         }
     }
     if !saw_thermo_style {
-        return Err(Error::External(format!(
-            "{} has no thermo_style line to extend",
-            input.display()
-        )));
+        return Err(Error::External(format!("{source} has no thermo_style line to extend")));
     }
     let dir = tempfile::tempdir().map_err(|e| Error::io("create temporary directory", std::env::temp_dir(), e))?;
     let copy = dir.path().join("in.settle");
@@ -419,13 +401,14 @@ pub fn bench_dem(opts: &DemBenchOptions) -> Result<()> {
         }
         return Ok(());
     }
-    let input = match &opts.liggghts_input {
-        Some(p) => p.clone(),
-        None => find_liggghts_input().ok_or_else(|| {
-            Error::External("cannot find ../shared/bench/liggghts/in.settle; pass --liggghts-input".into())
-        })?,
+    let (text, source) = match &opts.liggghts_input {
+        Some(p) => (
+            std::fs::read_to_string(p).map_err(|e| Error::io("read", p, e))?,
+            p.display().to_string(),
+        ),
+        None => (LIGGGHTS_INPUT.to_string(), "benches/liggghts/in.settle".to_string()),
     };
-    let (theirs, memory_mb) = run_liggghts(&opts.liggghts_binary, &input, opts.steps)?;
+    let (theirs, memory_mb) = run_liggghts(&opts.liggghts_binary, &text, &source, opts.steps)?;
     println!(
         "liggghts: {} particles, {} steps, 1 process: loop time {:.2} s, {:.4e} particle-steps/s{}",
         theirs.particles,
@@ -466,6 +449,32 @@ pub fn bench_dem(opts: &DemBenchOptions) -> Result<()> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The compiled-in LIGGGHTS input is the shared reference, where that is beside the checkout; and it sets up the
+    /// problem of `scenarios/bench-settle.yaml` (box, particle count from the lattice, material, steps).
+    #[test]
+    fn the_liggghts_input_is_the_shared_reference() {
+        let shared = Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/bench/liggghts/in.settle");
+        if let Ok(reference) = std::fs::read_to_string(&shared) {
+            assert_eq!(
+                LIGGGHTS_INPUT,
+                reference,
+                "benches/liggghts/in.settle differs from {}",
+                shared.display()
+            );
+        }
+        for line in [
+            "region reg block 0 0.06 0 0.06 0 0.3 units box",
+            "fix m1 all property/global youngsModulus peratomtype 1.0e7",
+            "fix m2 all property/global poissonsRatio peratomtype 0.33",
+            "run 20000",
+        ] {
+            assert!(
+                LIGGGHTS_INPUT.lines().any(|l| l.trim() == line),
+                "no `{line}` in the input"
+            );
+        }
+    }
 
     #[test]
     fn parses_a_liggghts_log() {

@@ -29,6 +29,7 @@ pub enum Command {
     /// Run one scenario (YAML) to its end time, with checkpoints and a time series; resumes when the output
     /// directory already holds a run of the same scenario.
     Simulate {
+        /// The scenario file (YAML; `granflow models` lists the model names it may use).
         scenario: PathBuf,
         /// Output directory (default: results/<scenario name>).
         #[arg(long)]
@@ -39,6 +40,7 @@ pub enum Command {
         /// Stop after this many steps in this invocation (the run stays resumable).
         #[arg(long)]
         max_steps: Option<u64>,
+        /// No progress output; the summary is still printed.
         #[arg(long)]
         quiet: bool,
     },
@@ -53,6 +55,7 @@ pub enum Command {
     Schema,
     /// Run a campaign: expand its sweep, run the jobs in worker processes, store their metrics.
     Run {
+        /// The campaign file (YAML; its schema: `granflow schema`).
         campaign: PathBuf,
         /// Campaign directory (default: results/<campaign name>).
         #[arg(long)]
@@ -65,18 +68,24 @@ pub enum Command {
     },
     /// Finish an interrupted campaign (after Ctrl-C, kill -9 or a reboot).
     Resume {
+        /// The campaign directory (it holds the campaign file as run).
         dir: PathBuf,
         #[command(flatten)]
         dispatch: DispatchArgs,
     },
     /// Jobs by state, running jobs' progress, failures with reasons, ETA.
-    Status { dir: PathBuf },
+    Status {
+        /// The campaign directory.
+        dir: PathBuf,
+    },
     /// Query a campaign's results: a pivot table of one metric over two parameters, or read-only SQL.
     Query {
+        /// The campaign directory.
         dir: PathBuf,
         /// Parameter for the columns and parameter for the rows (a swept path or its unique last key).
         #[arg(long, num_args = 2, value_names = ["PARAM_X", "PARAM_Y"], conflicts_with = "sql", requires = "metric")]
         pivot: Option<Vec<String>>,
+        /// With --pivot: the metric in the cells (the mean over jobs that share a cell).
         #[arg(long)]
         metric: Option<String>,
         /// With --pivot: only jobs whose parameter has this value (repeatable), e.g. `--where radius_m=0.00135`
@@ -86,33 +95,44 @@ pub enum Command {
         /// Any read-only SQL over the tables of schemas/results.sql.
         #[arg(long)]
         sql: Option<String>,
+        /// Output format.
         #[arg(long, value_enum, default_value = "table")]
         format: Format,
     },
     /// Parameters and metrics, one row per job.
     Export {
+        /// The campaign directory.
         dir: PathBuf,
+        /// Output format.
         #[arg(long, value_enum, default_value = "csv")]
         format: Format,
     },
     /// Recompute the metrics of every finished job with this build's reducers (after a reducer changed), from each
     /// job's final checkpoint and series; updates result.json, the database and the derived metrics.
-    Reduce { dir: PathBuf },
-    /// The validation report (Markdown) of a validation campaign: our numbers next to the source's, a verdict.
+    Reduce {
+        /// The campaign directory.
+        dir: PathBuf,
+    },
+    /// The validation report (Markdown) of a validation campaign (one with a `validation:` section): our numbers
+    /// next to the source's, a verdict.
     Report {
+        /// The campaign directory.
         dir: PathBuf,
         /// Write the report here (atomically) instead of printing it.
         #[arg(long)]
         out: Option<PathBuf>,
     },
     /// Map square-well depths onto Hamaker constants by the head-on escape velocity (seed 001 ch. 7): for each
-    /// well depth, the escape velocity and the Hamaker constant with the same one. Defaults: seed 001 Table 6.2.
+    /// well depth, the escape velocity and the Hamaker constant with the same one. Defaults: seed 001's beads and
+    /// contacts (Table 6.2) and well depths (Table 7.1).
     CohesionMap {
         /// Square-well depths D, J (seed 001 Table 7.1: 1e-11 5e-11 1e-10).
         #[arg(long, num_args = 1.., default_values_t = [1e-11, 5e-11, 1e-10])]
         well_depth_j: Vec<f64>,
+        /// Bead radius, m.
         #[arg(long, default_value_t = 0.5e-3)]
         radius_m: f64,
+        /// Bead density, kg/m³.
         #[arg(long, default_value_t = 2650.0)]
         density_kg_per_m3: f64,
         /// Linear spring stiffness K_n, N/m.
@@ -175,7 +195,7 @@ pub enum BenchCommand {
         /// work could gain on this machine) and `speedup_share_of_ceiling: <speedup / ceiling>`.
         #[arg(long)]
         ceiling: bool,
-        /// The LIGGGHTS input (default: ../shared/bench/liggghts/in.settle, searched upwards from here).
+        /// The LIGGGHTS input (default: the compiled-in copy of benches/liggghts/in.settle).
         #[arg(long)]
         liggghts_input: Option<PathBuf>,
         #[arg(long, default_value = "liggghts")]

@@ -120,22 +120,58 @@ pub fn status(dir: &Path) -> Result<String, Error> {
         .iter()
         .filter_map(|r| (r.status == JobStatus::Done).then_some(r.wall_time_s).flatten())
         .collect();
-    if !walls.is_empty() && pending + running > 0 {
-        let crate::campaign::spec::ExecutorSpec::Local(local) = &campaign.spec.executor;
-        let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
-        let parallel = local
-            .max_parallel
-            .unwrap_or((cores / local.threads_per_job.max(1)).max(1));
-        let mean = walls.iter().sum::<f64>() / walls.len() as f64;
+    // Each running job: its completed fraction, and, for a first attempt, the wall time it is on course for.
+    let running_jobs: Vec<(f64, Option<f64>)> = rows
+        .iter()
+        .filter(|r| r.status == JobStatus::Running)
+        .map(|r| {
+            let end = jobs_by_id
+                .get(r.job_id.as_str())
+                .map_or(f64::NAN, |j| j.scenario.time.end_time_s);
+            let fraction = (r.sim_time_s.unwrap_or(0.0) / end).clamp(0.0, 1.0);
+            let on_course = match (r.attempt, r.started_at, r.last_heartbeat) {
+                (1, Some(start), Some(beat)) if fraction >= 0.01 => Some((beat - start) / fraction),
+                _ => None,
+            };
+            (if fraction.is_finite() { fraction } else { 0.0 }, on_course)
+        })
+        .collect();
+    let crate::campaign::spec::ExecutorSpec::Local(local) = &campaign.spec.executor;
+    let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
+    let parallel = local
+        .max_parallel
+        .unwrap_or((cores / local.threads_per_job.max(1)).max(1));
+    if let Some((eta, per_job)) = status_eta(&walls, &running_jobs, pending, parallel) {
         out += &format!(
-            "ETA: about {:.0} s ({} jobs left × {:.1} s mean wall time / {} in parallel)\n",
-            mean * (pending + running) as f64 / parallel as f64,
+            "ETA: about {eta:.0} s ({} jobs left, {per_job:.1} s of wall time each{}, {parallel} in parallel)\n",
             pending + running,
-            mean,
-            parallel
+            if walls.is_empty() {
+                " as the running jobs are going"
+            } else {
+                " as the finished jobs took"
+            },
         );
     }
     Ok(out)
+}
+
+/// `granflow status`'s estimate of the time left and of one job's wall time: the finished jobs' mean wall time
+/// (`done_walls`) or, before any has finished, the mean of what the running jobs are on course for; `running`
+/// holds each running job's (completed fraction, wall time it is on course for, if known). `None` when nothing is
+/// left or there is nothing to go on.
+fn status_eta(
+    done_walls: &[f64],
+    running: &[(f64, Option<f64>)],
+    pending: usize,
+    parallel: usize,
+) -> Option<(f64, f64)> {
+    let on_course: Vec<f64> = running.iter().filter_map(|&(_, w)| w).collect();
+    let per_job = match (done_walls, on_course.as_slice()) {
+        ([], []) => return None,
+        ([], w) | (w, _) => w.iter().sum::<f64>() / w.len() as f64,
+    };
+    let jobs_left = pending as f64 + running.iter().map(|&(f, _)| 1.0 - f).sum::<f64>();
+    (jobs_left > 0.0).then(|| (per_job * jobs_left / parallel.max(1) as f64, per_job))
 }
 
 /// Resolves a user's parameter name to a stored parameter path: the exact path, or the unique path ending in it.
@@ -214,4 +250,25 @@ fn render(header: &[String], rows: &[Vec<serde_json::Value>], format: Format) ->
 /// The directory `run` uses for a campaign file.
 pub fn run_dir(campaign: &Campaign, out: Option<&Path>) -> PathBuf {
     campaign::output_dir(&campaign.spec, out)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::status_eta;
+
+    #[test]
+    fn status_eta_uses_finished_jobs_then_running_ones() {
+        // Two jobs done at 40 s each; one running, half done; two pending; two at a time: 2.5 jobs × 40 s / 2.
+        assert_eq!(
+            status_eta(&[40.0, 40.0], &[(0.5, Some(90.0))], 2, 2),
+            Some((50.0, 40.0))
+        );
+        // Nothing finished: the running jobs' courses (60 s and 80 s) give the per-job time.
+        let (eta, per_job) = status_eta(&[], &[(0.25, Some(60.0)), (0.5, Some(80.0))], 4, 2).unwrap();
+        assert_eq!(per_job, 70.0);
+        assert!((eta - 70.0 * 5.25 / 2.0).abs() < 1e-12, "{eta}");
+        // Nothing to go on (a resumed job has no course of its own), or nothing left.
+        assert_eq!(status_eta(&[], &[(0.5, None)], 3, 2), None);
+        assert_eq!(status_eta(&[30.0], &[], 0, 2), None);
+    }
 }
