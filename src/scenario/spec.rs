@@ -112,7 +112,7 @@ pub struct DrumSpec {
     pub axis_point_m: [f64; 3],
     pub axis: [f64; 3],
     pub radius_m: f64,
-    /// Rotation speed about `axis` (right-handed), revolutions per minute.
+    /// Rotation speed about `axis` (right-handed; negative turns the other way), revolutions per minute.
     pub rotation_rpm: f64,
     #[serde(default)]
     pub baffles: Vec<BaffleSpec>,
