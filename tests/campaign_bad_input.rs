@@ -583,15 +583,11 @@ const CASES: &[(&str, &str, &str, &[&str])] = &[
     ),
 ];
 
-/// The names in `dir`.
-/// Cases whose message rightly names a line other than the edit's: a key the edit deleted (its parent's line), or
-/// a fault of the whole sweep (the `sweep` key).
+/// Cases whose message rightly names a line other than the edit's: the edit deleted a key, and the message names
+/// the line of its parent, or of the metric that needs it.
 const LOCATED_ELSEWHERE: &[&str] = &[
     "missing base.time",
     "missing sweep",
-    "same value spelt twice",
-    "one axis name for two parameters",
-    "more jobs than max_jobs",
     "mixing metric without mixing_species",
 ];
 
@@ -600,6 +596,7 @@ fn located_line(stderr: &str) -> Option<usize> {
     stderr.strip_prefix("error: bad.yaml:")?.split(':').next()?.parse().ok()
 }
 
+/// The names in `dir`.
 fn listing(dir: &Path) -> BTreeSet<String> {
     std::fs::read_dir(dir)
         .expect("read temp dir")

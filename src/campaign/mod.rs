@@ -185,13 +185,20 @@ fn expand(
             ));
         }
     }
+    // The entry of a sweep axis in the file: where its `param` is, with `field` in place of `param`.
+    let axis_entry = |param: &str, field: &str| {
+        param_keys.get(param).map(|k| {
+            k.strip_suffix(".param")
+                .map_or(k.clone(), |axis| format!("{axis}.{field}"))
+        })
+    };
     for (k, (p, n)) in names.iter().enumerate() {
         if names[..k].iter().any(|(p2, n2)| n2 == n && p2 != p) {
-            return Err(invalid(
-                path,
-                "sweep",
-                format!("axis name `{n}` is given to two parameters"),
-            ));
+            let error = invalid(path, "sweep", format!("axis name `{n}` is given to two parameters"));
+            return Err(match axis_entry(p, "name") {
+                Some(entry) => error.at(yaml, &entry),
+                None => error,
+            });
         }
     }
     if points.len() > spec.max_jobs {
@@ -203,22 +210,33 @@ fn expand(
                 points.len(),
                 spec.max_jobs
             ),
-        ));
+        )
+        .at(yaml, "max_jobs"));
     }
     let base = base_document(&spec);
     let mut jobs = Vec::with_capacity(points.len());
     let mut seen: HashMap<String, usize> = HashMap::new();
+    // The points as written, to find which value two points that make one job spell differently.
+    let written_points = points.clone();
     for (ordinal, point) in points.into_iter().enumerate() {
         let job = resolve(&spec, &base, point, ordinal, param_keys, path)?;
         if let Some(&first) = seen.get(&job.job_id) {
-            return Err(invalid(
+            let error = invalid(
                 path,
                 "sweep",
                 format!(
                     "sweep points {first} and {ordinal} give the same job ({}); remove the duplicate",
                     describe(&job.params)
                 ),
-            ));
+            );
+            let spelt_differently = written_points[first].iter().find_map(|(param, value)| {
+                let other = written_points[ordinal].iter().find(|(p, _)| p == param)?;
+                (other.1 != *value).then_some(param.as_str())
+            });
+            return Err(match spelt_differently.and_then(|p| axis_entry(p, "values")) {
+                Some(entry) => error.at(yaml, &entry),
+                None => error,
+            });
         }
         seen.insert(job.job_id.clone(), ordinal);
         jobs.push(job);
