@@ -13,6 +13,7 @@ pub mod cli;
 pub mod engine;
 pub mod error;
 pub mod inspect;
+pub mod machine;
 mod models_doc;
 pub mod orchestrate;
 pub mod report;

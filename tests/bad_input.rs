@@ -188,6 +188,66 @@ const CASES: &[(&str, &str, &str, &[&str])] = &[
         "cohesion: { liquid_bridge: { surface_tension_n_per_m: 0.072, spray: { max_liquid_content: 0.0 } } }\ntime: {",
         &["cohesion.liquid_bridge.spray.max_liquid_content", "> 0"],
     ),
+    // Motions no time step can resolve: more than the smallest radius (1 mm) per step of 1e-5 s.
+    (
+        "an initial velocity of 1e5 m/s",
+        "fill:\n  - lattice: { species: glass, spacing_m: 0.0025, lo_m: [0.001, 0.001, 0.001], hi_m: [0.019, 0.019, 0.02] }",
+        "fill:\n  - explicit: { species: glass, positions_m: [[0.01, 0.01, 0.01]], velocities_m_per_s: [[1.0e5, 0.0, 0.0]] }",
+        &[
+            "fill[0].explicit.velocities_m_per_s[0]",
+            "an initial velocity of 1.000e5 m/s moves 1.000e0 m per time step",
+            "expected a speed below 1.000e2 m/s",
+        ],
+    ),
+    (
+        "an initial spin of 1e6 rad/s",
+        "fill:\n  - lattice: { species: glass, spacing_m: 0.0025, lo_m: [0.001, 0.001, 0.001], hi_m: [0.019, 0.019, 0.02] }",
+        "fill:\n  - explicit: { species: glass, positions_m: [[0.01, 0.01, 0.01]], angular_velocities_rad_per_s: [[0.0, 1.0e6, 0.0]] }",
+        &[
+            "fill[0].explicit.angular_velocities_rad_per_s[0]",
+            "expected below 1.000e5 rad/s",
+        ],
+    ),
+    (
+        "gravity of 1e9 m/s2",
+        "vector_m_per_s2: [0.0, 0.0, -9.81]",
+        "vector_m_per_s2: [0.0, 0.0, -1.0e9]",
+        &["gravity.vector_m_per_s2", "more than the smallest particle radius"],
+    ),
+    (
+        "a gas inflow of 1e5 m/s",
+        "time: {",
+        "gas: { density_kg_per_m3: 1.2, viscosity_pa_s: 1.8e-5, cells: [4, 4, 10], dem_steps_per_gas_step: 10, sides: { z_low: { inlet: { superficial_velocity_m_per_s: 1.0e5 } }, z_high: outlet } }\ntime: {",
+        &[
+            "gas.sides.z_low.inlet.superficial_velocity_m_per_s",
+            "a gas inflow of 1.000e5 m/s (at its highest level)",
+        ],
+    ),
+    (
+        "a jet of 500 m/s",
+        "time: {",
+        "gas: { density_kg_per_m3: 1.2, viscosity_pa_s: 1.8e-5, cells: [4, 4, 10], dem_steps_per_gas_step: 10, sides: { z_low: { inlet: { superficial_velocity_m_per_s: 1.0 } }, z_high: outlet }, jets: [{ side: z_low, lo_m: [0.0, 0.0, 0.0], hi_m: [0.01, 0.01, 0.0], superficial_velocity_m_per_s: 500.0 }] }\ntime: {",
+        &[
+            "gas.jets[0].superficial_velocity_m_per_s",
+            "a gas inflow of 5.000e2 m/s",
+        ],
+    ),
+    (
+        "a lattice spacing of 1e-300 m",
+        "spacing_m: 0.0025",
+        "spacing_m: 1.0e-300",
+        &["fill[0].lattice.spacing_m"],
+    ),
+    (
+        "a gas grid of 1e21 cells",
+        "time: {",
+        "gas: { density_kg_per_m3: 1.2, viscosity_pa_s: 1.8e-5, cells: [10000000, 10000000, 10000000], dem_steps_per_gas_step: 10, sides: { z_low: { inlet: { superficial_velocity_m_per_s: 1.0 } }, z_high: outlet } }\ntime: {",
+        &[
+            "gas.cells",
+            "1.000e21 gas cells at ~640 bytes",
+            "more than this machine's budget",
+        ],
+    ),
     (
         "unknown cohesion model",
         "time: {",
@@ -231,6 +291,51 @@ fn bad_scenarios_fail_cleanly_before_writing_anything() {
         assert_eq!(stderr.lines().count(), 1, "case '{case}': one message: {stderr}");
         assert!(!dir.join("bad-out").exists(), "case '{case}': wrote output");
     }
+}
+
+/// A scenario whose particles or gas cells would need more memory than the machine's budget is refused from its
+/// counts, before anything is allocated (`GRANFLOW_MEMORY_BYTES` stands in for a small machine).
+#[test]
+fn a_run_larger_than_the_memory_budget_is_refused_before_allocating() {
+    let tmp = tempfile::tempdir().expect("temp dir");
+    let dir = tmp.path();
+    // 32,320 lattice points (about 33 MB at 1 kB each) against a budget of 10 MB.
+    let big = GOOD
+        .replace("hi_m: [0.02, 0.02, 0.05]", "hi_m: [0.025, 0.025, 1.0]")
+        .replace("hi_m: [0.019, 0.019, 0.02]", "hi_m: [0.024, 0.024, 0.999]");
+    std::fs::write(dir.join("big.yaml"), &big).expect("write");
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_granflow"))
+        .args(["simulate", "big.yaml", "--out", "big-out"])
+        .env(granflow::machine::MEMORY_BUDGET_ENV, "10000000")
+        .current_dir(dir)
+        .output()
+        .expect("runs");
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{stderr}");
+    for f in [
+        "key `fill[0].lattice.spacing_m`",
+        "the run would need about 33.1 MB of memory (3.232e4 particles at ~1024 bytes",
+        "more than this machine's budget of 10.0 MB (set by GRANFLOW_MEMORY_BYTES)",
+    ] {
+        assert!(stderr.contains(f), "lacks `{f}`: {stderr}");
+    }
+    assert!(!dir.join("big-out").exists());
+    // The same file within a budget it fits runs.
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_granflow"))
+        .args([
+            "simulate",
+            "big.yaml",
+            "--out",
+            "big-out",
+            "--max-steps",
+            "1",
+            "--quiet",
+        ])
+        .env(granflow::machine::MEMORY_BUDGET_ENV, "100000000")
+        .current_dir(dir)
+        .output()
+        .expect("runs");
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
 }
 
 #[test]

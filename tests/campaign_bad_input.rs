@@ -391,6 +391,17 @@ const CASES: &[(&str, &str, &str, &[&str])] = &[
         ],
     ),
     (
+        "a drum at 1e30 rpm",
+        "values: [20.0, 60.0]",
+        "values: [20.0, 1.0e30]",
+        &[
+            "key `base.walls[0].drum.rotation_rpm`",
+            "the drum's surface speed (2.094e27 m/s at 1.000e30 rpm)",
+            "more than the smallest particle radius 1.5e-3 m",
+            "expected |rotation_rpm| below 3.581e4",
+        ],
+    ),
+    (
         "same value twice",
         "values: [20.0, 60.0]",
         "values: [20.0, 20.0]",
@@ -447,7 +458,60 @@ const CASES: &[(&str, &str, &str, &[&str])] = &[
         "more jobs than max_jobs",
         "seed: 7\n",
         "seed: 7\nmax_jobs: 3\n",
-        &["key `sweep`", "expands into 4 jobs, more than max_jobs = 3"],
+        &[
+            "key `sweep.grid[0].values`",
+            "the sweep expands into 4 jobs (its largest axis has 2 points), more than max_jobs = 3",
+            "raise `max_jobs`",
+        ],
+    ),
+    (
+        "max_jobs beyond its ceiling",
+        "seed: 7\n",
+        "seed: 7\nmax_jobs: 100000000000\n",
+        &["key `max_jobs`", "expected at most 1000000 jobs per campaign"],
+    ),
+    // Sweeps far too large: refused from their counts, before anything is expanded (tests/campaign_size.rs
+    // measures the time and memory of such refusals).
+    (
+        "a grid of 1e8 points",
+        "values: [20.0, 60.0]",
+        "linspace: { start: 1.0, stop: 60.0, num: 50000000 }",
+        &[
+            AT_EDIT,
+            "key `sweep.grid[0].linspace.num`",
+            "the sweep expands into 100000000 jobs (its largest axis has 50000000 points), more than max_jobs = 10000",
+            "raise `max_jobs` at the top level",
+        ],
+    ),
+    (
+        "a grid of 1e12 points",
+        "    - { param: walls.0.drum.rotation_rpm, name: rotation_rpm, values: [20.0, 60.0] }\n",
+        "    - { param: walls.0.drum.rotation_rpm, name: rotation_rpm, linspace: { start: 1.0, stop: 60.0, num: 1000000 } }\n    - { param: species.0.radius_m, linspace: { start: 0.001, stop: 0.0015, num: 500000 } }\n",
+        &[
+            AT_EDIT,
+            "key `sweep.grid[0].linspace.num`",
+            "the sweep expands into 1000000000000 jobs (its largest axis has 1000000 points)",
+        ],
+    ),
+    (
+        "a single linspace of 1e9 points",
+        SWEEP,
+        "sweep: { param: walls.0.drum.rotation_rpm, linspace: { start: 1.0, stop: 60.0, num: 1000000000 } }\n",
+        &[
+            AT_EDIT,
+            "key `sweep.linspace.num`",
+            "the sweep expands into 1000000000 jobs (its largest axis has 1000000000 points)",
+        ],
+    ),
+    (
+        "a single logspace of 1e9 points",
+        SWEEP,
+        "sweep: { param: walls.0.drum.rotation_rpm, logspace: { start: 1.0, stop: 60.0, num: 1000000000 } }\n",
+        &[
+            AT_EDIT,
+            "key `sweep.logspace.num`",
+            "the sweep expands into 1000000000 jobs (its largest axis has 1000000000 points)",
+        ],
     ),
     // Metrics, analysis, executor, checkpoints, name.
     (
@@ -584,11 +648,14 @@ const CASES: &[(&str, &str, &str, &[&str])] = &[
 ];
 
 /// Cases whose message rightly names a line other than the edit's: the edit deleted a key, and the message names
-/// the line of its parent, or of the metric that needs it.
+/// the line of its parent, or of the metric that needs it; or the case lowers a limit.
 const LOCATED_ELSEWHERE: &[&str] = &[
     "missing base.time",
     "missing sweep",
     "mixing metric without mixing_species",
+    // Lowering max_jobs makes the sweep too large; the message names the sweep's largest axis, where a typo of a
+    // few zeros would be.
+    "more jobs than max_jobs",
 ];
 
 /// The line of `error: bad.yaml:<line>:<column>: …`.

@@ -50,6 +50,26 @@ fn every_campaign_file_validates_against_the_schema_and_parses() {
     }
 }
 
+/// Every committed campaign's every job, and every committed scenario, passes the whole validation (particles
+/// built, the bounds of physics and memory checked): a new bound must not refuse a run the project ships.
+#[test]
+fn every_committed_job_and_scenario_validates() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let mut files = Vec::new();
+    campaign_files(&root.join("campaigns"), &mut files);
+    for file in files {
+        let campaign = granflow::campaign::load(&file).unwrap_or_else(|e| panic!("{}: {e}", file.display()));
+        granflow::campaign::validate_jobs(&campaign, &campaign.jobs, &file)
+            .unwrap_or_else(|e| panic!("{}: {e}", file.display()));
+    }
+    for entry in std::fs::read_dir(root.join("scenarios")).expect("scenarios/") {
+        let file = entry.expect("entry").path();
+        if file.extension().is_some_and(|e| e == "yaml") {
+            granflow::scenario::load(&file).unwrap_or_else(|e| panic!("{}: {e}", file.display()));
+        }
+    }
+}
+
 #[test]
 fn the_schema_rejects_what_the_parser_rejects() {
     let schema = granflow::campaign::json_schema();

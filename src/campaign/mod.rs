@@ -59,10 +59,7 @@ fn invalid(path: &Path, key: impl Into<String>, message: impl Into<String>) -> C
 
 /// Reads and expands a campaign file. Jobs are resolved but not yet validated as scenarios (see [`validate_jobs`]).
 pub fn load(path: &Path) -> Result<Campaign, ConfigError> {
-    let yaml = std::fs::read_to_string(path).map_err(|source| ConfigError::Read {
-        path: path.to_path_buf(),
-        source,
-    })?;
+    let yaml = scenario::read_input(path)?;
     from_yaml(&yaml, path)
 }
 
@@ -152,7 +149,8 @@ fn expand(
     if let Some(v) = &spec.validation {
         v.check(&spec.metrics).map_err(|(key, m)| invalid(path, key, m))?;
     }
-    let points = sweep::expand(&spec.sweep, "sweep").map_err(|e| invalid(path, e.key, e.message))?;
+    check_job_count(&spec, yaml, path)?;
+    let points = sweep::expand(&spec.sweep, "sweep", spec.max_jobs).map_err(|e| invalid(path, e.key, e.message))?;
     let names = sweep::axis_names(&spec.sweep);
     for (k, d) in spec.derived.iter().enumerate() {
         for m in d.required_metrics() {
@@ -201,18 +199,6 @@ fn expand(
             });
         }
     }
-    if points.len() > spec.max_jobs {
-        return Err(invalid(
-            path,
-            "sweep",
-            format!(
-                "expands into {} jobs, more than max_jobs = {}; raise max_jobs if this is intended",
-                points.len(),
-                spec.max_jobs
-            ),
-        )
-        .at(yaml, "max_jobs"));
-    }
     let base = base_document(&spec);
     let mut jobs = Vec::with_capacity(points.len());
     let mut seen: HashMap<String, usize> = HashMap::new();
@@ -247,6 +233,47 @@ fn expand(
         jobs,
         axis_names: names.into_iter().collect(),
     })
+}
+
+/// Refuses a sweep of more than `max_jobs` jobs, counted without expanding it, at the line of its largest axis
+/// (where a typo of a few zeros is), and a `max_jobs` above [`spec::MAX_JOBS_CEILING`] at its own line.
+fn check_job_count(spec: &CampaignSpec, yaml: &str, path: &Path) -> Result<(), ConfigError> {
+    if spec.max_jobs > spec::MAX_JOBS_CEILING {
+        return Err(invalid(
+            path,
+            "max_jobs",
+            format!(
+                "expected at most {} jobs per campaign, got {}; split the study into several campaigns",
+                spec::MAX_JOBS_CEILING,
+                spec.max_jobs
+            ),
+        )
+        .located(yaml));
+    }
+    let size = sweep::count(&spec.sweep, "sweep");
+    if size.points <= spec.max_jobs as u128 {
+        return Ok(());
+    }
+    let points = if size.points == u128::MAX {
+        format!("at least {}", u128::MAX)
+    } else {
+        size.points.to_string()
+    };
+    let (key, why) = match &size.largest_axis {
+        Some((key, n)) => (key.clone(), format!(" (its largest axis has {n} points)")),
+        None => ("sweep".to_string(), String::new()),
+    };
+    Err(invalid(
+        path,
+        key,
+        format!(
+            "the sweep expands into {points} jobs{why}, more than max_jobs = {}; if this is intended, raise \
+             `max_jobs` at the top level of the campaign file (at most {})",
+            spec.max_jobs,
+            spec::MAX_JOBS_CEILING
+        ),
+    )
+    .located(yaml))
 }
 
 /// Rejects non-finite numbers (`.nan`, `.inf`) in `base` and `sweep`: jobs are resolved through JSON, which has

@@ -25,14 +25,66 @@ fn fail(key: &str, message: impl Into<String>) -> SweepError {
     }
 }
 
-/// Expands `node` (found at `key` in the campaign file) into its points.
-pub fn expand(node: &SweepNode, key: &str) -> Result<Vec<Point>, SweepError> {
-    expand_node(node, key, false)
+/// How many points a sweep makes, counted from the tree without expanding anything.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SweepSize {
+    /// The number of points (saturating: a count beyond `u128::MAX` reads as `u128::MAX`).
+    pub points: u128,
+    /// The axis (a `param` or a `list`) with the most points, the first of equals: the key in the campaign file
+    /// that sets its length (`sweep.grid[1].linspace.num`, `sweep.grid[0].values`, `sweep.list`) and that length.
+    pub largest_axis: Option<(String, u128)>,
+}
+
+/// Counts the points of `node` (found at `key`) without materialising any: the product of a grid's children, the
+/// length of a zip (its longest child: in a valid file all are equal) or a list, the number of values or `num` of
+/// an axis. A malformed node (no kind, several kinds) counts as one point: [`expand`] reports it before it expands
+/// anything.
+pub fn count(node: &SweepNode, key: &str) -> SweepSize {
+    let mut largest: Option<(String, u128)> = None;
+    let points = count_node(node, key, &mut largest);
+    SweepSize {
+        points,
+        largest_axis: largest,
+    }
+}
+
+fn count_node(node: &SweepNode, key: &str, largest: &mut Option<(String, u128)>) -> u128 {
+    let mut note = |at: String, n: u128| {
+        if largest.as_ref().is_none_or(|(_, m)| n > *m) {
+            *largest = Some((at, n));
+        }
+        n
+    };
+    match (&node.param, &node.grid, &node.zip, &node.list) {
+        (Some(_), None, None, None) => match (&node.values, &node.linspace, &node.logspace) {
+            (Some(v), None, None) => note(format!("{key}.values"), v.len() as u128),
+            (None, Some(r), None) => note(format!("{key}.linspace.num"), r.num as u128),
+            (None, None, Some(r)) => note(format!("{key}.logspace.num"), r.num as u128),
+            _ => 1,
+        },
+        (None, Some(children), None, None) => children.iter().enumerate().fold(1u128, |n, (c, child)| {
+            n.saturating_mul(count_node(child, &format!("{key}.grid[{c}]"), largest))
+        }),
+        (None, None, Some(children), None) => children
+            .iter()
+            .enumerate()
+            .map(|(c, child)| count_node(child, &format!("{key}.zip[{c}]"), largest))
+            .max()
+            .unwrap_or(1),
+        (None, None, None, Some(points)) => note(format!("{key}.list"), points.len() as u128),
+        _ => 1,
+    }
+}
+
+/// Expands `node` (found at `key` in the campaign file) into its points. A range of more than `max_points` points
+/// is refused before anything is allocated (the caller checks the whole sweep's [`count`] first).
+pub fn expand(node: &SweepNode, key: &str, max_points: usize) -> Result<Vec<Point>, SweepError> {
+    expand_node(node, key, false, max_points)
 }
 
 /// As [`expand`]; `in_zip`: the node is a direct child of a zip, whose axes may repeat a value (the zipped
 /// tuples must still differ, which the campaign checks as duplicate jobs).
-fn expand_node(node: &SweepNode, key: &str, in_zip: bool) -> Result<Vec<Point>, SweepError> {
+fn expand_node(node: &SweepNode, key: &str, in_zip: bool, max_points: usize) -> Result<Vec<Point>, SweepError> {
     let kinds: Vec<&str> = [
         ("param", node.param.is_some()),
         ("grid", node.grid.is_some()),
@@ -58,9 +110,17 @@ fn expand_node(node: &SweepNode, key: &str, in_zip: bool) -> Result<Vec<Point>, 
         ));
     }
     match kinds.as_slice() {
-        ["param"] => axis(node, key, in_zip),
-        ["grid"] => grid(node.grid.as_deref().unwrap_or_default(), &format!("{key}.grid")),
-        ["zip"] => zip(node.zip.as_deref().unwrap_or_default(), &format!("{key}.zip")),
+        ["param"] => axis(node, key, in_zip, max_points),
+        ["grid"] => grid(
+            node.grid.as_deref().unwrap_or_default(),
+            &format!("{key}.grid"),
+            max_points,
+        ),
+        ["zip"] => zip(
+            node.zip.as_deref().unwrap_or_default(),
+            &format!("{key}.zip"),
+            max_points,
+        ),
         ["list"] => list(node.list.as_deref().unwrap_or_default(), &format!("{key}.list")),
         [] => Err(fail(
             key,
@@ -115,7 +175,7 @@ pub fn param_keys(node: &SweepNode, key: &str) -> Vec<(String, String)> {
     out
 }
 
-fn axis(node: &SweepNode, key: &str, allow_repeats: bool) -> Result<Vec<Point>, SweepError> {
+fn axis(node: &SweepNode, key: &str, allow_repeats: bool, max_points: usize) -> Result<Vec<Point>, SweepError> {
     let param = node.param.as_deref().unwrap_or_default();
     let param_key = format!("{key}.param");
     canonical_path(param).map_err(|m| fail(&param_key, m))?;
@@ -158,16 +218,16 @@ fn axis(node: &SweepNode, key: &str, allow_repeats: bool) -> Result<Vec<Point>, 
         }
         values.clone()
     } else if let Some(r) = &node.linspace {
-        spaced(r, &format!("{key}.linspace"), false)?
+        spaced(r, &format!("{key}.linspace"), false, max_points)?
     } else {
         let r = node.logspace.as_ref().expect("one of the three is set");
-        spaced(r, &format!("{key}.logspace"), true)?
+        spaced(r, &format!("{key}.logspace"), true, max_points)?
     };
     let path = canonical_path(param).expect("checked above");
     Ok(values.into_iter().map(|v| vec![(path.clone(), v)]).collect())
 }
 
-fn spaced(r: &Range, key: &str, geometric: bool) -> Result<Vec<Value>, SweepError> {
+fn spaced(r: &Range, key: &str, geometric: bool, max_points: usize) -> Result<Vec<Value>, SweepError> {
     if !(r.start.is_finite() && r.stop.is_finite()) {
         return Err(fail(
             key,
@@ -176,6 +236,12 @@ fn spaced(r: &Range, key: &str, geometric: bool) -> Result<Vec<Value>, SweepErro
     }
     if r.num == 0 {
         return Err(fail(&format!("{key}.num"), "expected at least one point, got 0"));
+    }
+    if r.num > max_points {
+        return Err(fail(
+            &format!("{key}.num"),
+            format!("expected at most {max_points} points (max_jobs), got {}", r.num),
+        ));
     }
     if geometric && !(r.start > 0.0 && r.stop > 0.0) {
         return Err(fail(
@@ -210,13 +276,19 @@ fn spaced(r: &Range, key: &str, geometric: bool) -> Result<Vec<Value>, SweepErro
         .collect()
 }
 
-fn grid(children: &[SweepNode], key: &str) -> Result<Vec<Point>, SweepError> {
+fn grid(children: &[SweepNode], key: &str, max_points: usize) -> Result<Vec<Point>, SweepError> {
     if children.is_empty() {
         return Err(fail(key, "expected at least one sweep, got an empty list"));
     }
     let mut points: Vec<Point> = vec![Vec::new()];
     for (c, child) in children.iter().enumerate() {
-        let child_points = expand(child, &format!("{key}[{c}]"))?;
+        let child_points = expand(child, &format!("{key}[{c}]"), max_points)?;
+        if points.len().saturating_mul(child_points.len()) > max_points {
+            return Err(fail(
+                key,
+                format!("expands into more than {max_points} points (max_jobs)"),
+            ));
+        }
         let mut next = Vec::with_capacity(points.len() * child_points.len());
         for p in &points {
             for q in &child_points {
@@ -230,14 +302,14 @@ fn grid(children: &[SweepNode], key: &str) -> Result<Vec<Point>, SweepError> {
     Ok(points)
 }
 
-fn zip(children: &[SweepNode], key: &str) -> Result<Vec<Point>, SweepError> {
+fn zip(children: &[SweepNode], key: &str, max_points: usize) -> Result<Vec<Point>, SweepError> {
     if children.is_empty() {
         return Err(fail(key, "expected at least one sweep, got an empty list"));
     }
     let expanded: Vec<Vec<Point>> = children
         .iter()
         .enumerate()
-        .map(|(c, child)| expand_node(child, &format!("{key}[{c}]"), true))
+        .map(|(c, child)| expand_node(child, &format!("{key}[{c}]"), true, max_points))
         .collect::<Result<_, _>>()?;
     let len = expanded[0].len();
     if let Some((c, other)) = expanded.iter().enumerate().find(|(_, e)| e.len() != len) {
@@ -483,7 +555,7 @@ mod tests {
             ]),
             ..Default::default()
         };
-        let points = expand(&node, "sweep").unwrap();
+        let points = expand(&node, "sweep", 100).unwrap();
         assert_eq!(points.len(), 6);
         assert_eq!(points[0], vec![("a".into(), json!(1)), ("b".into(), json!("x"))]);
         assert_eq!(points[1], vec![("a".into(), json!(1)), ("b".into(), json!("y"))]);
@@ -500,7 +572,7 @@ mod tests {
             ..Default::default()
         };
         assert_eq!(
-            expand(&ok, "sweep").unwrap()[1],
+            expand(&ok, "sweep", 100).unwrap()[1],
             vec![("a".into(), json!(2)), ("b".into(), json!(4))]
         );
         let bad = SweepNode {
@@ -510,7 +582,7 @@ mod tests {
             ]),
             ..Default::default()
         };
-        let e = expand(&bad, "sweep").unwrap_err();
+        let e = expand(&bad, "sweep", 100).unwrap_err();
         assert_eq!(e.key, "sweep.zip[1]");
     }
 
@@ -524,6 +596,7 @@ mod tests {
             },
             "k",
             false,
+            100,
         )
         .unwrap();
         assert_eq!(lin, vec![json!(1.0), json!(1.5), json!(2.0)]);
@@ -535,6 +608,7 @@ mod tests {
             },
             "k",
             true,
+            100,
         )
         .unwrap();
         assert_eq!(log[0], json!(0.01));
@@ -548,7 +622,8 @@ mod tests {
                     num: 3
                 },
                 "k",
-                true
+                true,
+                100
             )
             .is_err()
         );
@@ -560,7 +635,8 @@ mod tests {
                     num: 0
                 },
                 "k",
-                false
+                false,
+                100
             )
             .unwrap_err()
             .key,
@@ -596,15 +672,15 @@ mod tests {
 
     #[test]
     fn empty_and_ambiguous_nodes_are_rejected() {
-        assert!(expand(&SweepNode::default(), "sweep").is_err());
+        assert!(expand(&SweepNode::default(), "sweep", 100).is_err());
         let both = SweepNode {
             param: Some("a".into()),
             values: Some(vec![json!(1)]),
             grid: Some(vec![]),
             ..Default::default()
         };
-        assert!(expand(&both, "sweep").unwrap_err().message.contains("exactly one"));
+        assert!(expand(&both, "sweep", 100).unwrap_err().message.contains("exactly one"));
         let empty = axis_node("a", vec![]);
-        assert_eq!(expand(&empty, "sweep").unwrap_err().key, "sweep.values");
+        assert_eq!(expand(&empty, "sweep", 100).unwrap_err().key, "sweep.values");
     }
 }

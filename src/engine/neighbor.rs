@@ -61,12 +61,27 @@ struct CellGrid {
 }
 
 impl CellGrid {
+    /// The most cells a grid of n particles has: 27 per particle, and at least 2^20 (4 MB of cell starts). A
+    /// domain far larger than its particles (a few beads in a kilometre box) gets coarser cells instead of an
+    /// allocation the size of the domain; the lists found are the same (they are sorted), only the search is slower.
+    fn max_cells(particles: usize) -> f64 {
+        (27.0 * particles as f64).max((1u64 << 20) as f64)
+    }
+
     fn new(domain: &Domain, position: &[Vec3], cell_size_m: f64, team: &Team) -> Self {
         let length = domain.length_m();
-        let mut dims = [1usize; 3];
-        for axis in 0..3 {
-            dims[axis] = ((length[axis] / cell_size_m).floor() as usize).max(1);
+        let max_cells = Self::max_cells(position.len());
+        let mut size_m = cell_size_m;
+        let mut per_axis = [1.0f64; 3];
+        for _ in 0..64 {
+            per_axis = std::array::from_fn(|axis| (length[axis] / size_m).floor().max(1.0));
+            let cells = per_axis[0] * per_axis[1] * per_axis[2];
+            if cells <= max_cells {
+                break;
+            }
+            size_m *= (cells / max_cells).cbrt().max(1.01);
         }
+        let dims: [usize; 3] = per_axis.map(|n| n as usize);
         let cell: Vec<[u32; 3]> = map_indices(team, position.len(), BUILD_CHUNK, |i| {
             let x = &position[i];
             let mut c = [0u32; 3];

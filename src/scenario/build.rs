@@ -143,6 +143,7 @@ pub fn build(spec: ScenarioSpec, path: &Path) -> Result<BuiltScenario, ConfigErr
         c.positive("gravity.flip.frequency_hz", flip.frequency_hz)?;
     }
 
+    check_memory(&c, &spec)?;
     let walls = build_walls(&c, &spec, &species, &domain)?;
     let mut rng = RngState::from_seed_u64(spec.seed).restore();
     let particles = fill(&c, &spec, &species, &domain, &walls, &mut rng)?;
@@ -216,6 +217,8 @@ pub fn build(spec: ScenarioSpec, path: &Path) -> Result<BuiltScenario, ConfigErr
             return Err(c.fail("time", "give exactly one of dt_s and dt_fraction_of_contact_time"));
         }
     };
+
+    check_step_reach(&c, &spec, &particles, dt_s)?;
 
     let gas = match &spec.gas {
         None => None,
@@ -572,6 +575,235 @@ fn baffle_segments(
     Ok(out)
 }
 
+/// The most points a lattice fill may enumerate (most fall outside a drum or are cut by walls, so this is larger
+/// than any particle count a run can afford; the memory budget bounds the particles themselves).
+const MAX_LATTICE_POINTS: i128 = 50_000_000;
+
+/// A lattice's index range per axis, (first, last), of points `origin + k spacing` in [lo, hi).
+fn lattice_range(spacing_m: f64, lo_m: &[f64; 3], hi_m: &[f64; 3], origin_m: &[f64; 3]) -> [(i64, i64); 3] {
+    // `as i64` saturates, so an absurd spacing gives a huge range, not an overflow.
+    std::array::from_fn(|a| {
+        let first = ((lo_m[a] - origin_m[a]) / spacing_m).ceil() as i64;
+        let last = (((hi_m[a] - origin_m[a]) / spacing_m).ceil() as i64).saturating_sub(1);
+        (first, last)
+    })
+}
+
+/// The number of points of a lattice range (saturating).
+fn lattice_points(range: &[(i64, i64); 3]) -> i128 {
+    range
+        .iter()
+        .map(|&(a, b)| (b as i128 - a as i128 + 1).max(0))
+        .fold(1i128, |n, k| n.saturating_mul(k))
+}
+
+/// Estimated memory of a run, per particle: the engine's arrays (about 300 bytes), neighbour lists, contact
+/// history and the checkpoint writer's copies. Measured: 740 bytes per particle at the first checkpoint of the
+/// settling column at 29,160 and 120,204 particles (peak resident memory); rounded up.
+const BYTES_PER_PARTICLE: f64 = 1024.0;
+/// Estimated memory of a run, per gas cell: the fields, the SIMPLE loop's coefficients and the linear solvers'
+/// vectors. Measured: 590 bytes per cell in the pseudo-2-D bed at 256,000 and 1,024,000 cells; rounded up.
+const BYTES_PER_GAS_CELL: f64 = 640.0;
+
+/// Refuses a scenario whose particles and gas cells, counted from the spec before anything is allocated, would need
+/// more memory than the machine's budget ([`crate::machine::memory_budget_bytes`]). The key named is the fill entry
+/// with the most particles or `gas.cells`, whichever needs more.
+fn check_memory(c: &Checker, spec: &ScenarioSpec) -> Result<(), ConfigError> {
+    let mut per_fill: Vec<(String, f64)> = Vec::new();
+    for (k, f) in spec.fill.iter().enumerate() {
+        let (key, n) = match f {
+            FillSpec::Lattice {
+                spacing_m,
+                lo_m,
+                hi_m,
+                origin_m,
+                ..
+            } => {
+                if !(spacing_m.is_finite() && *spacing_m > 0.0) {
+                    continue; // reported by the fill's own checks
+                }
+                let n = lattice_points(&lattice_range(*spacing_m, lo_m, hi_m, origin_m));
+                (format!("fill[{k}].lattice.spacing_m"), n as f64)
+            }
+            FillSpec::Random { count, .. } => (format!("fill[{k}].random.count"), *count as f64),
+            FillSpec::Explicit { positions_m, .. } => {
+                (format!("fill[{k}].explicit.positions_m"), positions_m.len() as f64)
+            }
+        };
+        per_fill.push((key, n));
+    }
+    let particles: f64 = per_fill.iter().map(|(_, n)| n).sum();
+    if particles >= u32::MAX as f64 {
+        let (key, _) = per_fill
+            .iter()
+            .max_by(|a, b| a.1.total_cmp(&b.1))
+            .expect("a count this large has a fill entry");
+        return Err(c.fail(
+            key.clone(),
+            format!(
+                "the fills would make {particles:.3e} particles; expected fewer than {}",
+                u32::MAX
+            ),
+        ));
+    }
+    let cells: f64 = spec
+        .gas
+        .as_ref()
+        .map_or(0.0, |g| g.cells.iter().map(|&n| n as f64).product());
+    let Some((budget, source)) = crate::machine::memory_budget_bytes() else {
+        return Ok(());
+    };
+    let (particle_bytes, gas_bytes) = (particles * BYTES_PER_PARTICLE, cells * BYTES_PER_GAS_CELL);
+    let need = particle_bytes + gas_bytes;
+    if need <= budget as f64 {
+        return Ok(());
+    }
+    let key = if gas_bytes > particle_bytes {
+        "gas.cells".to_string()
+    } else {
+        per_fill
+            .iter()
+            .max_by(|a, b| a.1.total_cmp(&b.1))
+            .map_or("fill".to_string(), |(k, _)| k.clone())
+    };
+    Err(c.fail(
+        key,
+        format!(
+            "the run would need about {} of memory ({particles:.3e} particles at ~{BYTES_PER_PARTICLE} bytes, \
+             {cells:.3e} gas cells at ~{BYTES_PER_GAS_CELL} bytes), more than this machine's budget of {} ({source})",
+            crate::machine::bytes_text(need),
+            crate::machine::bytes_text(budget as f64),
+        ),
+    ))
+}
+
+/// Refuses motions no time step of `dt_s` can resolve: anything that would carry a particle further than its own
+/// radius in one step, where a contact would go from first touch to full overlap unseen.
+///
+/// CHOICE: the bound is one radius of the smallest particle per step. Contacts are resolved when an overlap grows
+/// over many steps (dt is a small fraction of the contact time); a particle that crosses its radius in one step
+/// overlaps by its whole radius before any force acts, and the run can only fail (max_overlap_fraction) or be
+/// meaningless. The bound is far above any resolved motion (at dt = t_c/20 a collision at the reference velocity
+/// moves a particle a few per cent of its radius per step), so no run that could work is refused. It applies to
+/// what the engine can see before the run: a drum's surface speed, a gas inflow or jet (at its highest level: a
+/// particle dragged along moves at most at about the gas's speed), a particle's initial velocity and spin, and the
+/// distance gravity moves a particle from rest in one step.
+fn check_step_reach(c: &Checker, spec: &ScenarioSpec, particles: &Particles, dt_s: f64) -> Result<(), ConfigError> {
+    let r_min = particles.radius_m.iter().copied().fold(f64::INFINITY, f64::min);
+    if !r_min.is_finite() {
+        return Ok(());
+    }
+    let per_step = |v: f64| v.abs() * dt_s;
+    let refuse = |key: String, what: String, v_m_per_s: f64| {
+        c.fail(
+            key,
+            format!(
+                "{what} moves {:.3e} m per time step (dt = {dt_s:e} s), more than the smallest particle radius \
+                 {r_min:e} m: no contact could be resolved; expected a speed below {:.3e} m/s",
+                per_step(v_m_per_s),
+                r_min / dt_s
+            ),
+        )
+    };
+    for (k, w) in spec.walls.iter().enumerate() {
+        if let WallSpec::Drum(d) = w {
+            let surface_m_per_s = d.rotation_rpm * 2.0 * PI / 60.0 * d.radius_m;
+            if per_step(surface_m_per_s) > r_min {
+                return Err(c.fail(
+                    format!("walls[{k}].drum.rotation_rpm"),
+                    format!(
+                        "the drum's surface speed ({:.3e} m/s at {:.3e} rpm) moves {:.3e} m per time step (dt = {dt_s:e} \
+                         s), more than the smallest particle radius {r_min:e} m: no contact could be resolved; \
+                         expected |rotation_rpm| below {:.3e}",
+                        surface_m_per_s.abs(),
+                        d.rotation_rpm,
+                        per_step(surface_m_per_s),
+                        r_min / dt_s / d.radius_m * 60.0 / (2.0 * PI)
+                    ),
+                ));
+            }
+        }
+    }
+    for (k, f) in spec.fill.iter().enumerate() {
+        let FillSpec::Explicit {
+            velocities_m_per_s,
+            angular_velocities_rad_per_s,
+            ..
+        } = f
+        else {
+            continue;
+        };
+        for (n, v) in velocities_m_per_s.iter().enumerate() {
+            let speed = Vec3::from(*v).norm();
+            if per_step(speed) > r_min {
+                return Err(refuse(
+                    format!("fill[{k}].explicit.velocities_m_per_s[{n}]"),
+                    format!("an initial velocity of {speed:.3e} m/s"),
+                    speed,
+                ));
+            }
+        }
+        for (n, w) in angular_velocities_rad_per_s.iter().enumerate() {
+            let spin = Vec3::from(*w).norm();
+            // A point of the surface moves ω r per step, r ≥ r_min: more than r whenever ω dt > 1.
+            if spin * dt_s > 1.0 {
+                return Err(c.fail(
+                    format!("fill[{k}].explicit.angular_velocities_rad_per_s[{n}]"),
+                    format!(
+                        "an initial spin of {spin:.3e} rad/s turns a particle by {:.3e} rad per time step (dt = \
+                         {dt_s:e} s), moving its surface more than its radius: expected below {:.3e} rad/s",
+                        spin * dt_s,
+                        1.0 / dt_s
+                    ),
+                ));
+            }
+        }
+    }
+    let g = Vec3::from(spec.gravity.vector_m_per_s2).norm();
+    if 0.5 * g * dt_s * dt_s > r_min {
+        return Err(c.fail(
+            "gravity.vector_m_per_s2",
+            format!(
+                "gravity of {g:.3e} m/s² moves a particle at rest {:.3e} m in one time step (dt = {dt_s:e} s), more \
+                 than the smallest particle radius {r_min:e} m; expected below {:.3e} m/s²",
+                0.5 * g * dt_s * dt_s,
+                2.0 * r_min / (dt_s * dt_s)
+            ),
+        ));
+    }
+    if let Some(flip) = spec.gravity.flip
+        && flip.frequency_hz * dt_s > 0.5
+    {
+        return Err(c.fail(
+            "gravity.flip.frequency_hz",
+            format!(
+                "a flip at {} Hz changes sign more often than every time step (dt = {dt_s:e} s); expected at most \
+                 {:.3e} Hz",
+                flip.frequency_hz,
+                0.5 / dt_s
+            ),
+        ));
+    }
+    if let Some(gas) = &spec.gas {
+        let highest_level = gas
+            .inflow_levels
+            .as_ref()
+            .map_or(1.0, |l| l.factors.iter().copied().fold(0.0, f64::max));
+        let inlets = super::gas::inlet_velocities(gas);
+        for (key, v) in inlets {
+            let v = v * highest_level;
+            if per_step(v) > r_min {
+                return Err(refuse(
+                    key,
+                    format!("a gas inflow of {v:.3e} m/s (at its highest level)"),
+                    v,
+                ));
+            }
+        }
+    }
+    Ok(())
+}
+
 /// True when a particle at `x` of radius `r` touches no wall and lies in the box.
 fn fits(x: &Vec3, r: f64, walls: &[Wall], domain: &Domain) -> bool {
     (0..3).all(|a| domain.periodic[a] || (x[a] - r >= domain.lo_m[a] && x[a] + r <= domain.hi_m[a]))
@@ -639,17 +871,12 @@ fn fill(
                         ),
                     ));
                 }
-                let mut range = [(0i64, 0i64); 3];
-                for a in 0..3 {
-                    let first = ((lo_m[a] - origin_m[a]) / spacing_m).ceil() as i64;
-                    let last = ((hi_m[a] - origin_m[a]) / spacing_m).ceil() as i64 - 1;
-                    range[a] = (first, last);
-                }
-                let count: i64 = range.iter().map(|(a, b)| (b - a + 1).max(0)).product();
-                if count > 50_000_000 {
+                let range = lattice_range(*spacing_m, lo_m, hi_m, origin_m);
+                let count = lattice_points(&range);
+                if count > MAX_LATTICE_POINTS {
                     return Err(c.fail(
                         key("spacing_m"),
-                        format!("the lattice would hold {count} points (limit 5e7)"),
+                        format!("the lattice would hold {count} points (limit {MAX_LATTICE_POINTS})"),
                     ));
                 }
                 let before = particles.len();

@@ -243,6 +243,29 @@ impl GasSetup {
     }
 }
 
+/// Every inflow velocity the spec gives, with its key: inlet sides, then jets (before any ramp or level).
+pub fn inlet_velocities(spec: &GasSpec) -> Vec<(String, f64)> {
+    let mut out = Vec::new();
+    for (k, name) in SIDE_NAMES.iter().enumerate() {
+        if let Some(SideSpec::Inlet {
+            superficial_velocity_m_per_s,
+        }) = spec.sides.get(k / 2, k % 2 == 1)
+        {
+            out.push((
+                format!("gas.sides.{name}.inlet.superficial_velocity_m_per_s"),
+                superficial_velocity_m_per_s,
+            ));
+        }
+    }
+    for (k, jet) in spec.jets.iter().enumerate() {
+        out.push((
+            format!("gas.jets[{k}].superficial_velocity_m_per_s"),
+            jet.superficial_velocity_m_per_s,
+        ));
+    }
+    out
+}
+
 type Fail<'a> = &'a dyn Fn(String, String) -> ConfigError;
 
 /// Checks the gas section against the domain and builds its configuration.
@@ -278,7 +301,7 @@ pub fn build_gas(
             format!("a pseudo-2-D bed has one gas cell in z, got {}", spec.cells[2]),
         ));
     }
-    if spec.cells.iter().product::<usize>() > 50_000_000 {
+    if spec.cells.iter().fold(1u128, |n, &k| n.saturating_mul(k as u128)) > 50_000_000 {
         return Err(fail(
             "gas.cells".into(),
             "more than 5e7 cells: expected a smaller grid".into(),

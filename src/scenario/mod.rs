@@ -139,11 +139,34 @@ pub fn with_suggestion(message: String) -> String {
     }
 }
 
-/// Reads, parses and validates a scenario file.
-pub fn load(path: &Path) -> Result<BuiltScenario, ConfigError> {
-    let text = std::fs::read_to_string(path).map_err(|source| ConfigError::Read {
+/// The largest input file (scenario or campaign) read: 64 MiB. A campaign's explicit list of ten thousand points or
+/// a fill of a hundred thousand explicit particles is a few megabytes; parsing takes several times a file's size in
+/// memory, so a file of gigabytes is refused before it is read.
+pub const MAX_INPUT_BYTES: u64 = 64 << 20;
+
+/// Reads an input file as text, refusing one larger than [`MAX_INPUT_BYTES`] before reading it.
+pub fn read_input(path: &Path) -> Result<String, ConfigError> {
+    let read_error = |source| ConfigError::Read {
         path: path.to_path_buf(),
         source,
-    })?;
+    };
+    let size = std::fs::metadata(path).map_err(read_error)?.len();
+    if size > MAX_INPUT_BYTES {
+        return Err(ConfigError::Yaml {
+            path: path.to_path_buf(),
+            line: 1,
+            column: 1,
+            message: format!(
+                "the file is {size} bytes, more than the {MAX_INPUT_BYTES} an input file may have; is it the \
+                 right file?"
+            ),
+        });
+    }
+    std::fs::read_to_string(path).map_err(read_error)
+}
+
+/// Reads, parses and validates a scenario file.
+pub fn load(path: &Path) -> Result<BuiltScenario, ConfigError> {
+    let text = read_input(path)?;
     build(parse(&text, path)?, path).map_err(|e| e.located(&text))
 }
