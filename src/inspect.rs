@@ -233,10 +233,46 @@ pub fn sql(dir: &Path, query: &str, format: Format) -> Result<String, Error> {
 }
 
 /// `granflow export`: parameters and metrics, one row per job.
+///
+/// Parameter columns follow the sweep's order (a zipped partner right after the axis it is zipped with), each named
+/// as it is stored: its axis name, or its parameter path when the sweep gives it none.
 pub fn export(dir: &Path, format: Format) -> Result<String, Error> {
-    let (store, id, _) = open(dir)?;
+    let (store, id, campaign) = open(dir)?;
     let (header, rows) = store.export_rows(id).map_err(store_err)?;
+    let (header, rows) = in_sweep_order(&campaign, header, rows);
     Ok(render(&header, &rows, format))
+}
+
+/// Reorders the `param.*` columns of an export by where the sweep sets each parameter (the order of a job's
+/// parameters); other columns keep their places.
+fn in_sweep_order(
+    campaign: &Campaign,
+    header: Vec<String>,
+    rows: Vec<Vec<serde_json::Value>>,
+) -> (Vec<String>, Vec<Vec<serde_json::Value>>) {
+    let sweep_order: Vec<String> = campaign
+        .jobs
+        .first()
+        .map(|job| {
+            job.params
+                .iter()
+                .map(|(path, _)| format!("param.{}", campaign.param_name(path)))
+                .collect()
+        })
+        .unwrap_or_default();
+    let param_columns: Vec<usize> = (0..header.len()).filter(|&k| header[k].starts_with("param.")).collect();
+    let mut sorted = param_columns.clone();
+    sorted.sort_by_key(|&k| sweep_order.iter().position(|p| *p == header[k]).unwrap_or(usize::MAX));
+    let mut order: Vec<usize> = (0..header.len()).collect();
+    for (slot, from) in param_columns.iter().zip(&sorted) {
+        order[*slot] = *from;
+    }
+    let header = order.iter().map(|&k| header[k].clone()).collect();
+    let rows = rows
+        .into_iter()
+        .map(|row| order.iter().map(|&k| row[k].clone()).collect())
+        .collect();
+    (header, rows)
 }
 
 fn render(header: &[String], rows: &[Vec<serde_json::Value>], format: Format) -> String {

@@ -16,6 +16,7 @@ pub mod inspect;
 pub mod machine;
 mod models_doc;
 pub mod orchestrate;
+pub mod provenance;
 pub mod report;
 pub mod scenario;
 pub mod simulate;

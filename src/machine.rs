@@ -1,4 +1,5 @@
-//! What this machine offers a run: the memory a scenario may plan to use.
+//! What this machine offers a run: the memory a scenario may plan to use, and whether the engine's hot loop may use
+//! the CPU's newer instructions.
 //!
 //! The budget is 80 % of the smaller of the physical memory and the memory limit of the process's control group
 //! (a Slurm job's allocation, a container's limit), or `GRANFLOW_MEMORY_BYTES` when set (a user sharing a login
@@ -70,4 +71,34 @@ pub fn bytes_text(bytes: f64) -> String {
         return format!("{:.1e} bytes", bytes);
     }
     format!("{value:.1} {unit}")
+}
+
+/// Environment variable that, set to `baseline`, keeps the engine on the x86-64 baseline instructions even where the
+/// CPU has newer ones (to compare the two paths; results are the same bits).
+pub const CPU_ENV: &str = "GRANFLOW_CPU";
+
+/// Whether the engine's force loop runs its x86-64-v3 compilation (AVX2, FMA, BMI1/2, LZCNT, POPCNT, MOVBE): true
+/// when the CPU has all of them and `GRANFLOW_CPU` is not `baseline`. Decided once per process.
+pub fn cpu_fast_path() -> bool {
+    static FAST: std::sync::OnceLock<bool> = std::sync::OnceLock::new();
+    *FAST.get_or_init(|| {
+        if std::env::var(CPU_ENV).is_ok_and(|v| v.trim() == "baseline") {
+            return false;
+        }
+        #[cfg(target_arch = "x86_64")]
+        {
+            std::arch::is_x86_feature_detected!("avx")
+                && std::arch::is_x86_feature_detected!("avx2")
+                && std::arch::is_x86_feature_detected!("fma")
+                && std::arch::is_x86_feature_detected!("bmi1")
+                && std::arch::is_x86_feature_detected!("bmi2")
+                && std::arch::is_x86_feature_detected!("lzcnt")
+                && std::arch::is_x86_feature_detected!("popcnt")
+                && std::arch::is_x86_feature_detected!("movbe")
+        }
+        #[cfg(not(target_arch = "x86_64"))]
+        {
+            false
+        }
+    })
 }

@@ -38,6 +38,30 @@ fill (list of):
   lattice: { species, spacing_m, lo_m, hi_m, origin_m?, inside_drum? }
   random: { species, count, lo_m, hi_m, inside_drum? }
 time: { end_time_s, dt_s | dt_fraction_of_contact_time, reference_velocity_m_per_s? }
+gas (optional: a gas coupled to the particles, fluidized beds):
+     { density_kg_per_m3, viscosity_pa_s, cells: [nx, ny, nz], dem_steps_per_gas_step, sides?, jets?, blocked?,
+       drag?, drag_velocities?, drag_coupling?, porosity?, min_porosity?, convection?, solver?, inflow_ramp?,
+       inflow_levels?, pressure_probe_height_m? }
+  sides: { x_low?, x_high?, y_low?, y_high?, z_low?, z_high? }, each one of:
+    wall                                                                 no-slip (default where not periodic)
+    periodic                                                             exactly where domain.periodic is
+    outlet                                                               zero gradient, pressure 0
+    inlet: { superficial_velocity_m_per_s }                              uniform inflow (a distributor)
+  jets (list of): { side, lo_m, hi_m, superficial_velocity_m_per_s }     faces of a side in a box (seed 002's jet)
+  blocked (list of): { lo_m, hi_m }                                      cells outside the gas
+  drag (default di_felice):
+    di_felice                                                            seed 000 eqs. 2.71-2.73
+    ergun_wen_yu                                                         seed 000 eq. 2.69 (eps^-2.65, C_d 0.44)
+    ergun_wen_yu_seed002                                                 seed 002 eqs. 29-31 (eps^-2.7, C_d 0.43)
+    syamlal_o_brien                                                      seed 001 eqs. 6.4-6.9
+  drag_velocities: instantaneous (default) | cell_averaged               seed 002 §3.3 methods 2 and 1
+  drag_coupling: explicit (default) | semi_implicit                      the gas's share of the drag
+  porosity: volume_split (default) | centre_binning                      particle volume into cells
+  convection: upwind (default) | hybrid
+  solver: { relax_velocity, relax_pressure, max_outer_iterations, mass_tolerance, velocity_tolerance,
+            linear_tolerance, max_linear_iterations, pressure_solver: auto (default) | direct | conjugate_gradient }
+  inflow_ramp: { start_s, duration_s? }                                  off until start_s, then linear to full
+  inflow_levels: { start_s?, hold_s, factors }                           held levels (seed 001's gas cycle)
 "#;
 
 #[cfg(test)]
@@ -45,6 +69,89 @@ mod tests {
     use super::MODELS;
     use crate::engine::models::cohesion_law::CohesionModel;
     use crate::engine::models::{ContactLaw, NormalModel, PlasticSlope, RollingModel, TangentialModel};
+
+    /// The names a closed choice of the scenario takes in YAML, read from its JSON Schema (plain strings and
+    /// single-key maps alike).
+    fn variant_names(schema: &serde_json::Value) -> Vec<String> {
+        let mut out = Vec::new();
+        if let Some(values) = schema.get("enum").and_then(|v| v.as_array()) {
+            out.extend(values.iter().filter_map(|v| v.as_str().map(String::from)));
+        }
+        if let Some(c) = schema.get("const").and_then(|v| v.as_str()) {
+            out.push(c.to_string());
+        }
+        for key in ["oneOf", "anyOf"] {
+            for alternative in schema.get(key).and_then(|v| v.as_array()).into_iter().flatten() {
+                out.extend(variant_names(alternative));
+                if let Some(props) = alternative.get("properties").and_then(|v| v.as_object())
+                    && alternative
+                        .get("required")
+                        .and_then(|r| r.as_array())
+                        .is_some_and(|r| r.len() == 1)
+                {
+                    out.extend(props.keys().cloned());
+                }
+            }
+        }
+        out
+    }
+
+    /// Every gas choice (drag laws, drag velocities and coupling, porosity methods, convection, pressure solvers,
+    /// side kinds) is listed under its YAML name, as are the inflow ramp and levels.
+    #[test]
+    fn every_gas_choice_is_listed() {
+        use crate::engine::gas::Convection;
+        use crate::engine::gas::coupling::PorosityMethod;
+        use crate::engine::gas::fluid_forces::{DragCoupling, DragVelocities};
+        use crate::engine::gas::linsolve::PressureSolver;
+        use crate::engine::models::drag::DragLaw;
+        use crate::scenario::gas::SideSpec;
+        let schemas = [
+            serde_json::to_value(schemars::schema_for!(DragLaw)).unwrap(),
+            serde_json::to_value(schemars::schema_for!(DragVelocities)).unwrap(),
+            serde_json::to_value(schemars::schema_for!(DragCoupling)).unwrap(),
+            serde_json::to_value(schemars::schema_for!(PorosityMethod)).unwrap(),
+            serde_json::to_value(schemars::schema_for!(Convection)).unwrap(),
+            serde_json::to_value(schemars::schema_for!(PressureSolver)).unwrap(),
+            serde_json::to_value(schemars::schema_for!(SideSpec)).unwrap(),
+        ];
+        let gas = &MODELS[MODELS.find("\ngas (optional").expect("a gas section")..];
+        let mut listed = 0;
+        for schema in &schemas {
+            let names = variant_names(schema);
+            assert!(names.len() >= 2, "no variants read from {schema}");
+            for name in names {
+                let as_word = |w: &str| {
+                    gas.match_indices(w).any(|(i, _)| {
+                        let before = gas[..i]
+                            .chars()
+                            .next_back()
+                            .is_none_or(|c| !c.is_alphanumeric() && c != '_');
+                        let after = gas[i + w.len()..]
+                            .chars()
+                            .next()
+                            .is_none_or(|c| !c.is_alphanumeric() && c != '_');
+                        before && after
+                    })
+                };
+                assert!(
+                    as_word(&name),
+                    "`granflow models` does not list the gas choice `{name}`"
+                );
+                listed += 1;
+            }
+        }
+        assert!(listed >= 18, "{listed}");
+        for key in [
+            "inflow_ramp",
+            "inflow_levels",
+            "jets",
+            "blocked",
+            "dem_steps_per_gas_step",
+        ] {
+            assert!(gas.contains(key), "{key}");
+        }
+    }
 
     /// Every model the enums define is listed, under the name the YAML and checkpoints use, and the listed forms
     /// parse.

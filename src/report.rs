@@ -136,6 +136,48 @@ fn cell(v: &Value) -> String {
     }
 }
 
+/// The campaign file a reader runs to reproduce the campaign: the one the user ran (as recorded at `granflow run`)
+/// when it still holds what was run; else, for campaigns recorded before the source was, the validation campaign of
+/// that name if it matches; else the stored copy in the campaign directory.
+fn reproduce_file(source: Option<&str>, yaml: &str, name: &str, dir: &Path) -> String {
+    let holds_it = |file: &Path| std::fs::read_to_string(file).ok().as_deref() == Some(yaml);
+    if let Some(source) = source {
+        if holds_it(Path::new(source)) {
+            return source.to_string();
+        }
+        return format!(
+            "{}  # as run; {source}, the file run, has changed since",
+            spec_copy_path(dir).display()
+        );
+    }
+    let file = Path::new("campaigns/validation").join(format!("{name}.yaml"));
+    if holds_it(&file) {
+        file.display().to_string()
+    } else {
+        spec_copy_path(dir).display().to_string()
+    }
+}
+
+/// The paragraph that says which builds finished the jobs, with a warning when there were several: a change of the
+/// engine's last bits moves single results (a chaotic bed by tens of per cent), so a report over mixed builds is
+/// not one engine's answer.
+fn builds_paragraph(builds: &[(String, i64)]) -> String {
+    match builds {
+        [] => String::new(),
+        [(build, n)] => format!("All {n} done jobs were run by granflow {build}.\n\n"),
+        several => {
+            let list: Vec<String> = several.iter().map(|(b, n)| format!("{b} ({n} jobs)")).collect();
+            format!(
+                "**The done jobs come from {} builds**: {}. Results of different builds can differ in their last \
+                 bits, and chaotic runs by much more; run the campaign again in a new directory for one build's \
+                 answer.\n\n",
+                several.len(),
+                list.join(", ")
+            )
+        }
+    }
+}
+
 /// The Markdown report of the validation campaign in `dir`, and whether every check passed.
 pub fn report(dir: &Path) -> Result<(String, bool), Error> {
     let campaign = crate::inspect::load_stored_campaign(dir)?;
@@ -146,11 +188,11 @@ pub fn report(dir: &Path) -> Result<(String, bool), Error> {
         )));
     };
     let store = Store::open_read_only(database_path(dir)).map_err(store_err)?;
-    let id = store
+    let stored = store
         .campaign_by_name(&campaign.spec.name)
         .map_err(store_err)?
-        .ok_or_else(|| Error::External(format!("{}: no campaign in the database", dir.display())))?
-        .id;
+        .ok_or_else(|| Error::External(format!("{}: no campaign in the database", dir.display())))?;
+    let id = stored.id;
     let (header, rows) = store.export_rows(id).map_err(store_err)?;
     let (_, derived_rows) = store
         .query_sql(&format!(
@@ -178,6 +220,24 @@ pub fn report(dir: &Path) -> Result<(String, bool), Error> {
         ))
         .map_err(store_err)?;
     let counts = store.status_counts(id).map_err(store_err)?;
+    // Which builds finished the done jobs (the attempt that ended `done`; NULL before builds were recorded).
+    let (_, build_rows) = store
+        .query_sql(&format!(
+            "SELECT COALESCE(a.build, 'unknown (finished before builds were recorded)'), COUNT(DISTINCT a.job_id)
+             FROM attempts a JOIN jobs j ON j.job_id = a.job_id
+             WHERE j.campaign_id = {id} AND j.status = 'done' AND a.outcome = 'done'
+             GROUP BY 1 ORDER BY 2 DESC, 1"
+        ))
+        .map_err(store_err)?;
+    let builds: Vec<(String, i64)> = build_rows
+        .iter()
+        .map(|r| {
+            (
+                r[0].as_str().unwrap_or_default().to_string(),
+                r[1].as_i64().unwrap_or(0),
+            )
+        })
+        .collect();
 
     let name = &campaign.spec.name;
     let mut md = String::new();
@@ -188,22 +248,19 @@ pub fn report(dir: &Path) -> Result<(String, bool), Error> {
         counts.get("done").copied().unwrap_or(0),
         campaign.jobs.len(),
         validation.source,
-        env!("CARGO_PKG_VERSION")
+        crate::provenance::build_id()
     );
+    md.push_str(&builds_paragraph(&builds));
     if !campaign.spec.description.trim().is_empty() {
         let _ = writeln!(md, "{}\n", campaign.spec.description.trim());
     }
-    let file = Path::new("campaigns/validation").join(format!("{name}.yaml"));
-    let campaign_file = if std::fs::read_to_string(&file).ok().as_deref() == Some(campaign.yaml.as_str()) {
-        file.display().to_string()
-    } else {
-        spec_copy_path(dir).display().to_string()
-    };
+    let campaign_file = reproduce_file(stored.source_path.as_deref(), &campaign.yaml, name, dir);
     let _ = writeln!(md, "## Reproduce\n\n```sh");
-    let _ = writeln!(md, "granflow run {campaign_file} --out results/{name}");
+    let _ = writeln!(md, "granflow run {campaign_file} --out {}", dir.display());
     let _ = writeln!(
         md,
-        "granflow report results/{name} --out results/validation/{name}/REPORT.md\n```\n"
+        "granflow report {} --out results/validation/{name}/REPORT.md\n```\n",
+        dir.display()
     );
     if !validation.choices.is_empty() {
         let _ = writeln!(md, "## Choices the source leaves open\n");
@@ -327,5 +384,20 @@ mod tests {
         assert!(result.pass);
         assert!(!same(&Value::from("null"), &serde_json::json!({ "square_well": null })));
         assert!(!same(&Value::from("text"), &Value::Null));
+    }
+
+    /// One build is named; several are named with their job counts and a warning.
+    #[test]
+    fn a_report_over_several_builds_says_so() {
+        assert_eq!(
+            builds_paragraph(&[("0.1.0+aaaa".into(), 6)]),
+            "All 6 done jobs were run by granflow 0.1.0+aaaa.\n\n"
+        );
+        let mixed = builds_paragraph(&[("0.1.0+aaaa".into(), 4), ("0.1.0+bbbb.dirty".into(), 2)]);
+        assert!(
+            mixed.starts_with("**The done jobs come from 2 builds**: 0.1.0+aaaa (4 jobs), 0.1.0+bbbb.dirty (2 jobs)."),
+            "{mixed}"
+        );
+        assert_eq!(builds_paragraph(&[]), "");
     }
 }

@@ -54,6 +54,10 @@ pub struct Summary {
     /// Refilters of the force pass's list from the candidates (the two-level scheme) in this invocation.
     #[serde(default)]
     pub neighbor_refilters: u64,
+    /// The build that ran this invocation ([`crate::provenance::build_id`]).
+    pub build: String,
+    /// The compilation of the force loop it ran ([`crate::provenance::cpu_path`]).
+    pub cpu_path: String,
 }
 
 const SERIES_HEADER: &str = "step,time_s,kinetic_energy_j,translational_kinetic_energy_j,bed_top_m,mean_height_m,pair_contacts,wall_contacts,mean_coordination";
@@ -533,6 +537,8 @@ pub fn run_in_dir(built: &BuiltScenario, out: &Path, ctl: RunControl) -> Result<
         stage_timings_s: sim.stage_timings(),
         neighbor_builds: sim.neighbor_builds(),
         neighbor_refilters: sim.neighbor_refilters(),
+        build: crate::provenance::build_id(),
+        cpu_path: crate::provenance::cpu_path().to_string(),
     };
     if summary.finished {
         let json = serde_json::to_string_pretty(&summary).expect("summary serialises");

@@ -135,6 +135,11 @@ fn a_campaign_runs_stores_every_job_and_pivots() {
     }
     let export = ok(&["export", out.to_str().unwrap(), "--format", "csv"], tmp.path());
     assert_eq!(export.lines().count(), 5, "{export}");
+    // Parameters in the sweep's order, the zipped partner (no axis name: its path) beside its named axis.
+    assert!(
+        export.starts_with("job_id,status,param.rotation_rpm,param.fill_top_m,param.fill[1].lattice.hi_m[1],metric."),
+        "{export}"
+    );
     let status = ok(&["status", out.to_str().unwrap()], tmp.path());
     assert!(status.contains("4 done"), "{status}");
 
@@ -476,4 +481,33 @@ fn reducing_a_finished_campaign_again_recomputes_its_metrics_bit_for_bit() {
     let refused = granflow(&["reduce", out.to_str().unwrap()], tmp.path());
     assert!(!refused.status.success());
     assert!(String::from_utf8_lossy(&refused.stderr).contains("is locked"));
+}
+
+/// The dispatcher runs fewer jobs at once than asked when that many would need more than the machine's memory
+/// budget (`GRANFLOW_MEMORY_BYTES` stands in for a small machine), says so, and still finishes every job.
+#[test]
+fn parallel_jobs_are_limited_by_the_memory_budget() {
+    let tmp = tempfile::tempdir().unwrap();
+    let file = write(tmp.path(), "mini.yaml", &campaign("[20.0, 60.0]", 0.002));
+    let loaded = granflow::campaign::load(&file).unwrap();
+    let largest = loaded
+        .jobs
+        .iter()
+        .map(|j| granflow::scenario::estimated_memory_bytes(&j.scenario))
+        .fold(0.0, f64::max);
+    // One job fits, two do not.
+    let budget = (1.5 * largest) as u64;
+    let out = Command::new(env!("CARGO_BIN_EXE_granflow"))
+        .args(["run", "mini.yaml", "--out", "out", "--quiet"])
+        .env(granflow::machine::MEMORY_BUDGET_ENV, budget.to_string())
+        .current_dir(tmp.path())
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{stderr}");
+    assert!(
+        stderr.contains("running at most 1 job(s) at once instead of 2"),
+        "{stderr}"
+    );
+    assert!(stderr.contains("4 done, 0 failed"), "{stderr}");
 }

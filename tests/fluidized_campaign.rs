@@ -101,6 +101,23 @@ fn a_fluidized_bed_campaign_stores_gas_metrics_derives_u_mf_and_reports() {
     assert_eq!(report.lines().next(), Some("# X1 smoke"), "{report}");
     assert_eq!(report.lines().last(), Some("verdict: pass"), "{report}");
     assert!(report.contains("granflow run ") && report.contains("300 steps only"));
+    // Provenance: the file the user ran, the build of every job (in the database and each result.json).
+    let build = granflow::provenance::build_id();
+    assert!(report.contains("granflow run bed.yaml --out bed\n"), "{report}");
+    assert!(
+        report.contains(&format!("All 6 done jobs were run by granflow {build}.")),
+        "{report}"
+    );
+    assert_eq!(sql("SELECT DISTINCT build FROM attempts"), format!("build\n{build}\n"));
+    let result_dir = std::fs::read_dir(dir.join("bed/jobs"))
+        .unwrap()
+        .next()
+        .unwrap()
+        .unwrap()
+        .path();
+    let result: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(result_dir.join("result.json")).unwrap()).unwrap();
+    assert_eq!(result["build"], build.as_str());
 
     // The same results judged by a range the bed weight misses: the verdict names the failed check.
     std::fs::write(dir.join("bed.yaml"), campaign("[100.0, 200.0]")).unwrap();

@@ -444,34 +444,49 @@ fn describe(point: &sweep::Point) -> String {
 
 /// Validates every given job of `campaign` as a scenario (geometry, materials, particles fitting), naming the sweep
 /// point of the first that fails and the line of `path`, the campaign's file, that sets the value. Builds the
-/// particles, so it costs what building the jobs costs.
+/// particles, so it costs what building the jobs costs. When the base scenario alone fails the same way, the sweep
+/// has nothing to do with the error and no sweep point is named.
 pub fn validate_jobs<'a>(
     campaign: &Campaign,
     jobs: impl IntoIterator<Item = &'a JobSpec>,
     path: &Path,
 ) -> Result<(), ConfigError> {
-    validate_each(jobs, path).map_err(|e| located(e, &campaign.yaml, &first_param_keys(&campaign.spec)))
+    let param_keys = first_param_keys(&campaign.spec);
+    let Some((job, key, message)) = jobs
+        .into_iter()
+        .find_map(|job| {
+            job_error(job, path).err().map(|e| match e {
+                ConfigError::Invalid { key, message, .. } => Ok((job, key, message)),
+                other => Err(other),
+            })
+        })
+        .transpose()?
+    else {
+        return Ok(());
+    };
+    let base = base_document(&campaign.spec);
+    let base_job = resolve(&campaign.spec, &base, Vec::new(), 0, &param_keys, path)?;
+    let base_fails_alike = matches!(
+        job_error(&base_job, path),
+        Err(ConfigError::Invalid { key: k, message: m, .. }) if k == key && m == message
+    );
+    let message = if base_fails_alike || job.params.is_empty() {
+        message
+    } else {
+        format!("{message} (at sweep point {})", describe(&job.params))
+    };
+    Err(located(invalid(path, key, message), &campaign.yaml, &param_keys))
 }
 
-fn validate_each<'a>(jobs: impl IntoIterator<Item = &'a JobSpec>, path: &Path) -> Result<(), ConfigError> {
-    for job in jobs {
-        if let Err(e) = scenario::build(job.scenario.clone(), path) {
-            let point = describe(&job.params);
-            return Err(match e {
-                ConfigError::Invalid { key, message, .. } => invalid(
-                    path,
-                    format!("base.{key}"),
-                    format!("{message} (at sweep point {point})"),
-                ),
-                other => other,
-            });
-        }
-        metrics::check_job(job).map_err(|(key, m)| {
-            let point = describe(&job.params);
-            invalid(path, key, format!("{m} (at sweep point {point})"))
-        })?;
+/// The first problem of one job as a scenario (keys of the scenario prefixed with `base.`) or with its metrics.
+fn job_error(job: &JobSpec, path: &Path) -> Result<(), ConfigError> {
+    if let Err(e) = scenario::build(job.scenario.clone(), path) {
+        return Err(match e {
+            ConfigError::Invalid { key, message, .. } => invalid(path, format!("base.{key}"), message),
+            other => other,
+        });
     }
-    Ok(())
+    metrics::check_job(job).map_err(|(key, m)| invalid(path, key, m))
 }
 
 /// The JSON Schema of the campaign file, generated from the types that parse it (`schemas/campaign.schema.json` is

@@ -1076,9 +1076,58 @@ fn parallel<const WB: bool, const TH: bool>(
 /// each range (see [`range_sweep`]): its interior with `CROSS` false, and its boundary layer with `CROSS` true, where
 /// a partner beyond the window is not evaluated but its result taken from `buffers` (phase A of [`parallel`]). One
 /// function for all, so the interior of a range runs the same machine code as the one-thread pass.
+///
+/// Compiled twice, for the x86-64 baseline and for x86-64-v3 (AVX2, FMA, BMI), and dispatched at run time
+/// ([`crate::machine::cpu_fast_path`]): the default build runs on any x86-64 machine and still uses the newer
+/// instructions where they exist. Both give the same bits: Rust never fuses a multiply and an add on its own, and
+/// the one explicit `mul_add` is exact either way (tests/portable_build.rs compares them).
 #[allow(clippy::too_many_arguments)]
 #[inline(never)]
 fn sweep<const WB: bool, const TH: bool, const CROSS: bool>(
+    ctx: Context,
+    window: &ListWindow,
+    lo: usize,
+    particles: std::ops::Range<usize>,
+    motion: (&mut [Vec3], &mut [Vec3], &mut [Vec3]),
+    force: &mut [Vec3],
+    torque: &mut [Vec3],
+    pairs: ColumnsMut,
+    walls: ColumnsMut,
+    buffers: &PairBuffers,
+) -> Tally {
+    #[cfg(target_arch = "x86_64")]
+    if crate::machine::cpu_fast_path() {
+        // SAFETY: `cpu_fast_path` is true only where the CPU has every feature `sweep_x86_64_v3` is compiled for.
+        return unsafe {
+            sweep_x86_64_v3::<WB, TH, CROSS>(ctx, window, lo, particles, motion, force, torque, pairs, walls, buffers)
+        };
+    }
+    sweep_body::<WB, TH, CROSS>(ctx, window, lo, particles, motion, force, torque, pairs, walls, buffers)
+}
+
+/// [`sweep_body`] compiled for x86-64-v3's instructions.
+#[cfg(target_arch = "x86_64")]
+#[allow(clippy::too_many_arguments)]
+#[target_feature(enable = "avx,avx2,fma,bmi1,bmi2,lzcnt,popcnt,movbe")]
+fn sweep_x86_64_v3<const WB: bool, const TH: bool, const CROSS: bool>(
+    ctx: Context,
+    window: &ListWindow,
+    lo: usize,
+    particles: std::ops::Range<usize>,
+    motion: (&mut [Vec3], &mut [Vec3], &mut [Vec3]),
+    force: &mut [Vec3],
+    torque: &mut [Vec3],
+    pairs: ColumnsMut,
+    walls: ColumnsMut,
+    buffers: &PairBuffers,
+) -> Tally {
+    sweep_body::<WB, TH, CROSS>(ctx, window, lo, particles, motion, force, torque, pairs, walls, buffers)
+}
+
+/// The loop of [`sweep`], inlined into each of its compilations.
+#[allow(clippy::too_many_arguments)]
+#[inline(always)]
+fn sweep_body<const WB: bool, const TH: bool, const CROSS: bool>(
     ctx: Context,
     window: &ListWindow,
     lo: usize,

@@ -59,6 +59,33 @@ pub fn database_path(out: &Path) -> PathBuf {
     out.join("campaign.sqlite")
 }
 
+/// `asked` jobs at once, or fewer when that many of the campaign's largest job would need more than the machine's
+/// memory budget (each job alone fits: validation refuses one that does not); says so when it lowers the number.
+fn parallel_within_memory(campaign: &Campaign, asked: usize) -> usize {
+    let Some((budget, _)) = crate::machine::memory_budget_bytes() else {
+        return asked;
+    };
+    let largest = campaign
+        .jobs
+        .iter()
+        .map(|j| crate::scenario::estimated_memory_bytes(&j.scenario))
+        .fold(0.0, f64::max);
+    if largest <= 0.0 {
+        return asked;
+    }
+    let fits = ((budget as f64 / largest).floor() as usize).max(1);
+    if fits < asked {
+        let note = format!(
+            "running at most {fits} job(s) at once instead of {asked}: each needs about {} of the {} memory budget",
+            crate::machine::bytes_text(largest),
+            crate::machine::bytes_text(budget as f64)
+        );
+        eprintln!("{note}");
+        tracing::warn!("{note}");
+    }
+    fits.min(asked)
+}
+
 /// The campaign directory's copy of the campaign file (what `resume` runs).
 pub fn spec_copy_path(out: &Path) -> PathBuf {
     out.join("campaign.yaml")
@@ -102,9 +129,14 @@ pub fn run_campaign(campaign: &Campaign, source: &Path, out: &Path, opts: &Dispa
             &campaign.spec.name,
             &campaign.yaml,
             &spec_hash,
-            env!("CARGO_PKG_VERSION"),
+            &crate::provenance::build_id(),
         )
         .map_err(store_err)?;
+    if source != copy {
+        store
+            .set_campaign_source(campaign_id, &source.display().to_string())
+            .map_err(store_err)?;
+    }
     let new_jobs: Vec<NewJob> = campaign
         .jobs
         .iter()
@@ -157,11 +189,12 @@ pub fn run_campaign(campaign: &Campaign, source: &Path, out: &Path, opts: &Dispa
     let ExecutorSpec::Local(local) = &campaign.spec.executor;
     let threads = opts.threads_per_job.unwrap_or(local.threads_per_job).max(1);
     let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
-    let max_parallel = opts
+    let asked_parallel = opts
         .max_parallel
         .or(local.max_parallel)
         .unwrap_or((cores / threads).max(1))
         .max(1);
+    let max_parallel = parallel_within_memory(campaign, asked_parallel);
     let settings = Settings {
         out: out.to_path_buf(),
         threads,
@@ -304,6 +337,7 @@ fn store_result(store: &mut Store, job_id: &str, result: &worker::JobResult, fin
         wall_time_s: result.wall_time_s,
         steps: result.steps,
         finished_at,
+        build: result.build.clone(),
     };
     store.finish_job(job_id, &stored).map_err(store_err)
 }
@@ -408,7 +442,13 @@ async fn dispatch(
             match spawn(&job, settings, dt_halvings, tx.clone()) {
                 Ok((child_pid, stdin)) => {
                     store
-                        .mark_running(&job.job_id, attempt, &hostname(), store::unix_time_s())
+                        .mark_running(
+                            &job.job_id,
+                            attempt,
+                            &hostname(),
+                            store::unix_time_s(),
+                            &crate::provenance::build_id(),
+                        )
                         .map_err(store_err)?;
                     let label = labels.get(&job.job_id).cloned().unwrap_or_default();
                     tracing::info!(job = %job.job_id, attempt, params = %label, "started");

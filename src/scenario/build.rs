@@ -605,10 +605,9 @@ const BYTES_PER_PARTICLE: f64 = 1024.0;
 /// vectors. Measured: 590 bytes per cell in the pseudo-2-D bed at 256,000 and 1,024,000 cells; rounded up.
 const BYTES_PER_GAS_CELL: f64 = 640.0;
 
-/// Refuses a scenario whose particles and gas cells, counted from the spec before anything is allocated, would need
-/// more memory than the machine's budget ([`crate::machine::memory_budget_bytes`]). The key named is the fill entry
-/// with the most particles or `gas.cells`, whichever needs more.
-fn check_memory(c: &Checker, spec: &ScenarioSpec) -> Result<(), ConfigError> {
+/// The number of particles each fill entry makes, counted from the spec (a lattice's points before walls cut it),
+/// with the key that sets it.
+fn particles_per_fill(spec: &ScenarioSpec) -> Vec<(String, f64)> {
     let mut per_fill: Vec<(String, f64)> = Vec::new();
     for (k, f) in spec.fill.iter().enumerate() {
         let (key, n) = match f {
@@ -632,6 +631,25 @@ fn check_memory(c: &Checker, spec: &ScenarioSpec) -> Result<(), ConfigError> {
         };
         per_fill.push((key, n));
     }
+    per_fill
+}
+
+/// The memory a run of `spec` is estimated to need, in bytes, from its particle and gas cell counts (before anything
+/// is built); what [`build`] compares with the machine's budget, and the dispatcher with its parallel jobs.
+pub fn estimated_memory_bytes(spec: &ScenarioSpec) -> f64 {
+    let particles: f64 = particles_per_fill(spec).iter().map(|(_, n)| n).sum();
+    let cells: f64 = spec
+        .gas
+        .as_ref()
+        .map_or(0.0, |g| g.cells.iter().map(|&n| n as f64).product());
+    particles * BYTES_PER_PARTICLE + cells * BYTES_PER_GAS_CELL
+}
+
+/// Refuses a scenario whose particles and gas cells, counted from the spec before anything is allocated, would need
+/// more memory than the machine's budget ([`crate::machine::memory_budget_bytes`]). The key named is the fill entry
+/// with the most particles or `gas.cells`, whichever needs more.
+fn check_memory(c: &Checker, spec: &ScenarioSpec) -> Result<(), ConfigError> {
+    let per_fill = particles_per_fill(spec);
     let particles: f64 = per_fill.iter().map(|(_, n)| n).sum();
     if particles >= u32::MAX as f64 {
         let (key, _) = per_fill

@@ -8,7 +8,7 @@ pub mod spec;
 
 use std::path::{Path, PathBuf};
 
-pub use build::{BuiltScenario, build};
+pub use build::{BuiltScenario, build, estimated_memory_bytes};
 pub use spec::ScenarioSpec;
 
 /// Invalid input, found before anything runs or is written.

@@ -19,8 +19,10 @@ pub struct Campaign {
     pub spec_hash: String,
     /// Unix seconds of the first run.
     pub created_at: f64,
-    /// granflow version of the latest run.
+    /// granflow build of the latest run (its version before schema 2).
     pub engine_version: String,
+    /// The campaign file as the user named it at the latest `granflow run`, if recorded.
+    pub source_path: Option<String>,
 }
 
 impl Store {
@@ -48,11 +50,23 @@ impl Store {
             .context(&self.path, format_args!("recording campaign `{name}`"))
     }
 
+    /// Records the campaign file the user ran (as named on the command line) for campaign `id`.
+    pub fn set_campaign_source(&mut self, id: i64, source_path: &str) -> Result<(), StoreError> {
+        self.conn
+            .execute(
+                "UPDATE campaigns SET source_path = ?2 WHERE id = ?1",
+                params![id, source_path],
+            )
+            .context(&self.path, format_args!("recording the source of campaign {id}"))?;
+        Ok(())
+    }
+
     /// The campaign called `name`, if stored.
     pub fn campaign_by_name(&self, name: &str) -> Result<Option<Campaign>, StoreError> {
         self.conn
             .query_row(
-                "SELECT id, name, spec_yaml, spec_hash, created_at, engine_version FROM campaigns WHERE name = ?1",
+                "SELECT id, name, spec_yaml, spec_hash, created_at, engine_version, source_path FROM campaigns
+                 WHERE name = ?1",
                 [name],
                 |row| {
                     Ok(Campaign {
@@ -62,6 +76,7 @@ impl Store {
                         spec_hash: row.get(3)?,
                         created_at: row.get(4)?,
                         engine_version: row.get(5)?,
+                        source_path: row.get(6)?,
                     })
                 },
             )

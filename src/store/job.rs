@@ -149,6 +149,8 @@ pub struct JobResult {
     pub steps: u64,
     /// Unix seconds.
     pub finished_at: f64,
+    /// The build that finished the job (`result.json`'s `build`; empty when unknown).
+    pub build: String,
 }
 
 /// What happens to a job after a failed attempt; the retry policy that chooses it lives with the dispatcher.

@@ -80,10 +80,18 @@ impl Store {
         Ok(inserted)
     }
 
-    /// Records the start of `attempt` (1-based) of `job_id` on `host` at `started_at` (unix seconds): the job
-    /// becomes `running` and a new row of its attempt history opens. An attempt still open from before (a dispatcher
-    /// that died without [`Store::reset_running_to_pending`]) is closed as interrupted.
-    pub fn mark_running(&mut self, job_id: &str, attempt: u32, host: &str, started_at: f64) -> Result<(), StoreError> {
+    /// Records the start of `attempt` (1-based) of `job_id` on `host` at `started_at` (unix seconds) by the granflow
+    /// `build` that runs it: the job becomes `running` and a new row of its attempt history opens. An attempt still
+    /// open from before (a dispatcher that died without [`Store::reset_running_to_pending`]) is closed as
+    /// interrupted.
+    pub fn mark_running(
+        &mut self,
+        job_id: &str,
+        attempt: u32,
+        host: &str,
+        started_at: f64,
+        build: &str,
+    ) -> Result<(), StoreError> {
         let path = &self.path;
         let action = format!("marking job {job_id} as running");
         let tx = self
@@ -107,8 +115,9 @@ impl Store {
         )
         .context(path, &action)?;
         tx.execute(
-            "INSERT INTO attempts (job_id, attempt, host, outcome, started_at) VALUES (?1, ?2, ?3, 'running', ?4)",
-            params![job_id, attempt, host, started_at],
+            "INSERT INTO attempts (job_id, attempt, host, outcome, started_at, build)
+             VALUES (?1, ?2, ?3, 'running', ?4, ?5)",
+            params![job_id, attempt, host, started_at, build],
         )
         .context(path, &action)?;
         tx.commit().context(path, &action)
@@ -235,8 +244,9 @@ impl Store {
             }
         }
         tx.execute(
-            "UPDATE attempts SET outcome = 'done', ended_at = ?2 WHERE job_id = ?1 AND outcome = 'running'",
-            params![job_id, result.finished_at],
+            "UPDATE attempts SET outcome = 'done', ended_at = ?2, build = COALESCE(NULLIF(?3, ''), build)
+             WHERE job_id = ?1 AND outcome = 'running'",
+            params![job_id, result.finished_at, result.build],
         )
         .context(path, &action)?;
         tx.commit().context(path, &action)
@@ -379,7 +389,9 @@ mod tests {
         let (_dir, mut store, campaign) = new_campaign();
         let mut jobs = sample_jobs();
         assert_eq!(store.insert_jobs(campaign, &jobs).unwrap(), 6);
-        store.mark_running(&jobs[0].job_id, 1, "node1", 10.0).unwrap();
+        store
+            .mark_running(&jobs[0].job_id, 1, "node1", 10.0, "0.1.0+test")
+            .unwrap();
 
         // Re-registering with changed data for a known id and one new job: only the new job is written.
         jobs[0].params_json = "{\"changed\":true}".to_string();
@@ -430,7 +442,7 @@ mod tests {
         let jobs = sample_jobs();
         store.insert_jobs(campaign, &jobs).unwrap();
         let id = &jobs[0].job_id;
-        store.mark_running(id, 1, "node1", 100.0).unwrap();
+        store.mark_running(id, 1, "node1", 100.0, "0.1.0+test").unwrap();
         assert!(store.heartbeat(id, 0.5, 500, 110.0).unwrap());
         let result = job_result(&[("porosity", 0.4, ""), ("dp_mean", 1200.0, "Pa")]);
         store.finish_job(id, &result).unwrap();
@@ -485,14 +497,14 @@ mod tests {
         store.insert_jobs(campaign, &jobs).unwrap();
         let (a, b) = (&jobs[0].job_id, &jobs[1].job_id);
 
-        store.mark_running(a, 1, "node1", 1.0).unwrap();
+        store.mark_running(a, 1, "node1", 1.0, "0.1.0+test").unwrap();
         store
             .mark_failed(a, 1, "numerical", "non-finite velocity", 2.0, AfterFailure::Retry)
             .unwrap();
         let row = &store.job_summaries(campaign).unwrap()[0];
         assert_eq!(row.status, JobStatus::Pending);
         assert_eq!(row.exit_class.as_deref(), Some("numerical"));
-        store.mark_running(a, 2, "node2", 3.0).unwrap();
+        store.mark_running(a, 2, "node2", 3.0, "0.1.0+test").unwrap();
         store
             .mark_failed(a, 2, "crash", "signal 9", 4.0, AfterFailure::Final)
             .unwrap();
@@ -502,7 +514,7 @@ mod tests {
             (JobStatus::Failed, 2, Some(4.0))
         );
 
-        store.mark_running(b, 1, "node1", 5.0).unwrap();
+        store.mark_running(b, 1, "node1", 5.0, "0.1.0+test").unwrap();
         assert_eq!(store.reset_running_to_pending(campaign).unwrap(), 1);
         assert_eq!(store.status_counts(campaign).unwrap()["running"], 0);
 
@@ -521,7 +533,7 @@ mod tests {
         ];
         assert_eq!(history, expected);
 
-        let err = store.mark_running("nope", 1, "h", 0.0).unwrap_err();
+        let err = store.mark_running("nope", 1, "h", 0.0, "0.1.0+test").unwrap_err();
         assert!(err.to_string().contains("has no job nope"), "{err}");
     }
 }

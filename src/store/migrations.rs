@@ -12,7 +12,10 @@ use rusqlite::{Connection, TransactionBehavior};
 use super::error::{Context, StoreError};
 
 /// The SQL of each migration, in order. Append only: a released migration is never edited.
-const MIGRATIONS: &[&str] = &[include_str!("../../schemas/results.sql")];
+const MIGRATIONS: &[&str] = &[
+    include_str!("../../schemas/results.sql"),
+    include_str!("../../schemas/results-2-build.sql"),
+];
 
 /// The schema version this build reads and writes (the number of migrations).
 pub const SCHEMA_VERSION: i64 = MIGRATIONS.len() as i64;
@@ -97,6 +100,35 @@ mod tests {
         let store = Store::open(&path).unwrap();
         assert_eq!(store.campaign_by_name("c").unwrap().unwrap().id, id);
         assert_eq!(store.schema_version().unwrap(), SCHEMA_VERSION);
+    }
+
+    /// A database written by a build of schema 1 (campaigns, jobs and attempts but no builds) opens, migrates to the
+    /// current schema keeping its rows, and reads its missing builds and source as NULL.
+    #[test]
+    fn a_version_1_database_migrates_keeping_its_rows() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("campaign.sqlite");
+        let conn = Connection::open(&path).unwrap();
+        conn.execute_batch(MIGRATIONS[0]).unwrap();
+        conn.pragma_update(None, "user_version", 1).unwrap();
+        conn.execute_batch(
+            "INSERT INTO campaigns (name, spec_yaml, spec_hash, created_at, engine_version)
+                 VALUES ('old', 'a: 1', 'h', 1.0, '0.1.0');
+             INSERT INTO jobs (job_id, campaign_id, ordinal, params_json, status, attempt)
+                 VALUES ('j1', 1, 0, '{}', 'done', 1);
+             INSERT INTO attempts (job_id, attempt, outcome, started_at, ended_at) VALUES ('j1', 1, 'done', 2.0, 3.0);",
+        )
+        .unwrap();
+        drop(conn);
+        let store = Store::open(&path).unwrap();
+        assert_eq!(store.schema_version().unwrap(), SCHEMA_VERSION);
+        let campaign = store.campaign_by_name("old").unwrap().unwrap();
+        assert_eq!(
+            (campaign.engine_version.as_str(), campaign.source_path),
+            ("0.1.0", None)
+        );
+        let (_, rows) = store.query_sql("SELECT job_id, build FROM attempts").unwrap();
+        assert_eq!(rows, vec![vec![serde_json::json!("j1"), serde_json::Value::Null]]);
     }
 
     #[test]

@@ -264,7 +264,7 @@ mod tests {
 
         let writer = std::thread::spawn(move || {
             for job in &jobs {
-                store.mark_running(&job.job_id, 1, "node", 1.0).unwrap();
+                store.mark_running(&job.job_id, 1, "node", 1.0, "0.1.0+test").unwrap();
                 let result = test_support::job_result(&[("m", 1.0, ""), ("n", 2.0, "Pa")]);
                 store.finish_job(&job.job_id, &result).unwrap();
             }

@@ -52,6 +52,7 @@ pub(crate) fn job_result(metrics: &[(&str, f64, &str)]) -> JobResult {
             .collect(),
         timings: vec![("forces".to_string(), 12.0), ("gas".to_string(), 6.5)],
         sim_time_s: 1.0,
+        build: "0.1.0+test".into(),
         wall_time_s: 20.0,
         steps: 1000,
         finished_at: 1000.0,
@@ -60,6 +61,8 @@ pub(crate) fn job_result(metrics: &[(&str, f64, &str)]) -> JobResult {
 
 /// Runs `job_id` through start and result with the given metrics.
 pub(crate) fn finish(store: &mut Store, job_id: &str, metrics: &[(&str, f64, &str)]) {
-    store.mark_running(job_id, 1, "node1", 900.0).expect("mark running");
+    store
+        .mark_running(job_id, 1, "node1", 900.0, "0.1.0+test")
+        .expect("mark running");
     store.finish_job(job_id, &job_result(metrics)).expect("finish job");
 }

@@ -30,8 +30,9 @@ use crate::simulate::{RunControl, RunEvent, RunObserver, run_in_dir, write_atomi
 
 pub use reduce::Metric;
 
-/// Format version of `result.json`.
-pub const RESULT_FORMAT: u32 = 1;
+/// Format version of `result.json`: 2 adds `build`, `cpu_path` and `reduced_by` (a version-1 file reads with
+/// them empty).
+pub const RESULT_FORMAT: u32 = 2;
 
 /// What `result.json` holds.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -45,6 +46,15 @@ pub struct JobResult {
     pub sim_time_s: f64,
     /// Wall time of the invocation that finished the job (earlier attempts are in the database).
     pub wall_time_s: f64,
+    /// The build that finished the job ([`crate::provenance::build_id`]; empty in results older than format 2).
+    #[serde(default)]
+    pub build: String,
+    /// The compilation of the force loop it ran ([`crate::provenance::cpu_path`]; the same bits either way).
+    #[serde(default)]
+    pub cpu_path: String,
+    /// The build whose reducers last recomputed the metrics (`granflow reduce`), when not the one that ran the job.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub reduced_by: Option<String>,
 }
 
 /// Options of one worker invocation.
@@ -168,6 +178,9 @@ fn run(opts: &WorkerOptions) -> Result<i32, Error> {
         steps: sim.step,
         sim_time_s: sim.time_s,
         wall_time_s: start.elapsed().as_secs_f64(),
+        build: crate::provenance::build_id(),
+        cpu_path: crate::provenance::cpu_path().to_string(),
+        reduced_by: None,
     };
     let json = serde_json::to_string_pretty(&result).expect("results serialise");
     write_atomic(&result_path, json.as_bytes())?;

@@ -41,8 +41,10 @@ pub fn reduce_again(job_dir: &Path) -> Result<JobResult, Error> {
     let mut sim = Simulation::restore(built.config.clone(), state, 1)?;
     attach_gas(&built, &mut sim, gas.as_ref())?;
     let series = reduce::Series::read(&job_dir.join("series.csv"))?;
+    let this_build = crate::provenance::build_id();
     let result = JobResult {
         metrics: reduce::metrics(&job, &built, &sim, &series)?,
+        reduced_by: (old.build != this_build).then_some(this_build),
         ..old
     };
     let json = serde_json::to_string_pretty(&result).expect("results serialise");
