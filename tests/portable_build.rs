@@ -79,7 +79,7 @@ fn run(dir: &Path, scenario: &str, out: &str, threads: &str, baseline: bool) -> 
         "x86-64-v3"
     };
     assert_eq!(summary["cpu_path"], expected, "{out}");
-    CheckpointSeries::new(&dir.join(out), 1)
+    CheckpointSeries::new(dir.join(out), 1)
         .latest_valid()
         .expect("lists")
         .expect("a checkpoint")
