@@ -33,7 +33,10 @@ fn floats(v: &[f64]) -> String {
 }
 
 fn vectors<'a>(v: impl IntoIterator<Item = &'a Vec3>) -> String {
-    digest(v.into_iter().flat_map(|x| [x.x.to_bits(), x.y.to_bits(), x.z.to_bits()]))
+    digest(
+        v.into_iter()
+            .flat_map(|x| [x.x.to_bits(), x.y.to_bits(), x.z.to_bits()]),
+    )
 }
 
 /// One digest per field of the state, by a stable name (independent of how the engine stores it).
@@ -101,7 +104,13 @@ pub fn digests(s: &SimState) -> BTreeMap<String, String> {
     );
     d.insert(
         "cohesion.pairs.bridge_volume_m3".into(),
-        floats(&s.cohesion.pairs.iter().map(|(_, _, c)| c.bridge_volume_m3).collect::<Vec<_>>()),
+        floats(
+            &s.cohesion
+                .pairs
+                .iter()
+                .map(|(_, _, c)| c.bridge_volume_m3)
+                .collect::<Vec<_>>(),
+        ),
     );
     d.insert(
         "cohesion.pairs.in_well".into(),
@@ -113,14 +122,23 @@ pub fn digests(s: &SimState) -> BTreeMap<String, String> {
     );
     d.insert(
         "cohesion.walls.bridge_volume_m3".into(),
-        floats(&s.cohesion.walls.iter().map(|(_, _, c)| c.bridge_volume_m3).collect::<Vec<_>>()),
+        floats(
+            &s.cohesion
+                .walls
+                .iter()
+                .map(|(_, _, c)| c.bridge_volume_m3)
+                .collect::<Vec<_>>(),
+        ),
     );
     d.insert(
         "cohesion.walls.in_well".into(),
         digest(s.cohesion.walls.iter().map(|(_, _, c)| c.in_well as u64)),
     );
     if let Some(g) = &s.gas {
-        d.insert("gas.time_s".into(), digest([g.time_s.to_bits(), g.reaction_steps as u64]));
+        d.insert(
+            "gas.time_s".into(),
+            digest([g.time_s.to_bits(), g.reaction_steps as u64]),
+        );
         d.insert("gas.pressure_pa".into(), floats(&g.pressure_pa));
         d.insert("gas.porosity".into(), floats(&g.porosity));
         for k in 0..3 {
@@ -171,12 +189,17 @@ fn reference_runs() -> Vec<(&'static str, SimState)> {
     let mut runs = Vec::new();
     // The benchmark's settling column (29,160 Hertz-Mindlin spheres), 5,000 steps on two threads (the bottom
     // layers land at about 3,000).
-    runs.push(("bench-settle", run(parse(&scenario_text("scenarios/bench-settle.yaml")), 5000, 2)));
+    runs.push((
+        "bench-settle",
+        run(parse(&scenario_text("scenarios/bench-settle.yaml")), 5000, 2),
+    ));
     // The quickstart drum at 60 rpm and the half fill, 3,000 steps.
     runs.push((
         "quickstart-drum",
         run(
-            campaign_job("campaigns/quickstart.yaml", |p| p.contains("60.0") && p.contains(":0.0")),
+            campaign_job("campaigns/quickstart.yaml", |p| {
+                p.contains("60.0") && p.contains(":0.0")
+            }),
             3000,
             1,
         ),
@@ -250,10 +273,20 @@ fn reference_runs_end_in_their_recorded_bits() {
     // The runs exercise what they are meant to: contacts, bridges to walls, cohesion states, the gas.
     let state = |name: &str| &runs.iter().find(|(n, _)| *n == name).expect("run").1;
     assert!(!state("bench-settle").contacts.pairs.is_empty());
-    assert!(state("thornton-drum-baffles").contacts.pairs.iter().any(|(_, _, h)| h.yielded));
+    assert!(
+        state("thornton-drum-baffles")
+            .contacts
+            .pairs
+            .iter()
+            .any(|(_, _, h)| h.yielded)
+    );
     assert!(!state("wet-bed-wall-bridges").cohesion.walls.is_empty());
     assert!(!state("wet-bed-wall-bridges").cohesion.pairs.is_empty());
     assert!(state("seed-001-hamaker").gas.is_some());
     assert!(!state("seed-001-square-well").cohesion.pairs.is_empty());
-    assert!(problems.is_empty(), "fields that differ from {REFERENCE}:\n{}", problems.join("\n"));
+    assert!(
+        problems.is_empty(),
+        "fields that differ from {REFERENCE}:\n{}",
+        problems.join("\n")
+    );
 }

@@ -67,11 +67,7 @@ impl Cohesion {
             }
         };
         let n = species.len();
-        let contact_angle_rad: Vec<f64> = species
-            .species
-            .iter()
-            .map(|s| s.contact_angle_deg.to_radians())
-            .collect();
+        let contact_angle_rad: Vec<f64> = species.species.iter().map(|s| s.contact_angle_rad).collect();
         let mut cohesion = Cohesion {
             model,
             range_m: 0.0,
@@ -107,22 +103,10 @@ impl Cohesion {
                 positive("cohesion.liquid_bridge.min_gap_m", cohesion.min_gap_m)?;
                 let mut largest_liquid = 0.0f64;
                 let mut largest_angle = 0.0f64;
-                for (k, s) in species.species.iter().enumerate() {
-                    let key = |f: &str| format!("species[{k}].{f}");
-                    if !(s.liquid_content.is_finite() && s.liquid_content >= 0.0) {
-                        return Err((
-                            key("liquid_content"),
-                            format!("expected a finite value >= 0, got {}", s.liquid_content),
-                        ));
-                    }
-                    if !(s.contact_angle_deg.is_finite() && (0.0..90.0).contains(&s.contact_angle_deg)) {
-                        return Err((
-                            key("contact_angle_deg"),
-                            format!("expected 0 <= θ < 90 (a wetting liquid), got {}", s.contact_angle_deg),
-                        ));
-                    }
+                // (The species' liquid and contact angles are validated by the scenario, where their keys live.)
+                for s in &species.species {
                     largest_liquid = largest_liquid.max(s.liquid_content * s.radius_m.powi(3));
-                    largest_angle = largest_angle.max(s.contact_angle_deg.to_radians());
+                    largest_angle = largest_angle.max(s.contact_angle_rad);
                 }
                 if let Some(spray) = b.spray {
                     if !(spray.max_liquid_content.is_finite() && spray.max_liquid_content > 0.0) {
@@ -162,11 +146,11 @@ impl Cohesion {
                         cohesion.rupture.push(RuptureTable::new(
                             a.radius_m,
                             b.radius_m,
-                            a.contact_angle_deg.to_radians(),
-                            b.contact_angle_deg.to_radians(),
-                            a.radius_m == b.radius_m && a.contact_angle_deg == b.contact_angle_deg,
+                            a.contact_angle_rad,
+                            b.contact_angle_rad,
+                            a.radius_m == b.radius_m && a.contact_angle_rad == b.contact_angle_rad,
                         ));
-                        let (ta, tb) = (a.contact_angle_deg.to_radians(), b.contact_angle_deg.to_radians());
+                        let (ta, tb) = (a.contact_angle_rad, b.contact_angle_rad);
                         // Mikami's fit only where it is settled: equal particles at θ = 0 (B2).
                         let mikami_settled = a.radius_m == b.radius_m && ta == 0.0 && tb == 0.0;
                         cohesion.capillary.push(

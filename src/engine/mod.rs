@@ -3,6 +3,7 @@
 //! later, by workers.
 
 pub mod cohesion;
+pub mod config;
 pub mod contacts;
 pub mod error;
 pub mod forces;

@@ -30,9 +30,10 @@ impl SpeciesId {
     }
 }
 
-/// A particle material. Walls are species too (with an infinite radius, see `geometry::walls`).
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, schemars::JsonSchema)]
-#[serde(deny_unknown_fields)]
+/// A particle material as the engine uses it: SI units throughout (the scenario's `species` entries, with their
+/// contact angle in degrees, are converted in `scenario/build.rs`). Walls are species too (with an infinite radius,
+/// see `geometry::walls`).
+#[derive(Debug, Clone, PartialEq)]
 pub struct Species {
     pub name: String,
     /// Nominal radius of particles created from this species (walls ignore it).
@@ -42,24 +43,13 @@ pub struct Species {
     pub poisson_ratio: f64,
     /// Coulomb sliding friction coefficient μ.
     pub friction_coefficient: f64,
-    /// Thornton yield force F_y (seed 000 eq. 2.7; "essentially a fitting parameter"). Only the Thornton normal
-    /// model reads it; `None` means the material never yields.
-    #[serde(default)]
+    /// Thornton yield force F_y (seed 000 eq. 2.7); `None`: the material never yields.
     pub yield_force_n: Option<f64>,
     /// Rolling-resistance coefficient μ_r for the optional rolling slot (dimensionless).
-    #[serde(default)]
     pub rolling_friction_coefficient: f64,
-    /// Reserved for the heat-transfer issue: solid conductivity and heat capacity.
-    #[serde(default)]
-    pub thermal_conductivity_w_per_m_k: Option<f64>,
-    #[serde(default)]
-    pub heat_capacity_j_per_kg_k: Option<f64>,
-    /// Contact angle θ of the cohesion model's liquid on this material, degrees (liquid bridges; default 0).
-    #[serde(default)]
-    pub contact_angle_deg: f64,
-    /// Liquid each particle of this species carries at the start, as V̂ = V/R³ (liquid bridges; seed 000 sprays
-    /// up to 0.02; default 0: dry).
-    #[serde(default)]
+    /// Contact angle θ of the cohesion model's liquid on this material, rad.
+    pub contact_angle_rad: f64,
+    /// Liquid each particle of this species carries at the start, as V̂ = V/R³.
     pub liquid_content: f64,
 }
 
@@ -83,16 +73,14 @@ impl Species {
             friction_coefficient: 0.3,
             yield_force_n: None,
             rolling_friction_coefficient: 0.0,
-            thermal_conductivity_w_per_m_k: None,
-            heat_capacity_j_per_kg_k: None,
-            contact_angle_deg: 0.0,
+            contact_angle_rad: 0.0,
             liquid_content: 0.0,
         }
     }
 }
 
 /// All species of a simulation, indexed by [`SpeciesId`].
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, Default, schemars::JsonSchema)]
+#[derive(Debug, Clone, PartialEq, Default)]
 pub struct SpeciesTable {
     pub species: Vec<Species>,
 }

@@ -8,17 +8,16 @@
 use std::sync::Arc;
 use std::time::{Duration, Instant};
 
-use super::cohesion::{AlignedCohesion, Cohesion, CohesionPass, apply_cohesion, total_liquid_m3};
+use super::cohesion::{AlignedCohesion, CohesionPass, apply_cohesion, total_liquid_m3};
+pub use super::config::SimConfig;
 use super::contacts::AlignedHistory;
 use super::forces::{ForcePass, HalfKick, PairBuffers, RangePlan, add_wall_contact_forces, compute_contact_forces};
 use super::gas::coupled::GasCoupling;
-use super::geometry::{Domain, Gravity, Wall};
 use super::integrate::{InverseInertia, find_lost, kick_drift};
 use super::models::cohesion_law::{CohesionModel, LiquidBridge};
-use super::models::{ContactLaw, PairTable};
-use super::neighbor::{Criteria, NeighborList, Reach};
+use super::neighbor::{Criteria, NeighborList};
 use super::net_force::NetForceTally;
-use super::particles::{ParticleId, Particles, SpeciesTable};
+use super::particles::{ParticleId, Particles};
 use super::spray::spray_surface;
 use super::state::{RngState, SimState};
 use super::team::Team;
@@ -30,45 +29,6 @@ const PARALLEL_FLUID_FORCES_MIN_PARTICLES: usize = 1000;
 
 /// Steps after which the parallel ranges are rebalanced from measured times even without a neighbour-list build.
 const REBALANCE_EVERY_STEPS: u64 = 200;
-
-/// Everything about a simulation that does not change while it runs.
-#[derive(Debug, Clone)]
-pub struct SimConfig {
-    pub domain: Domain,
-    /// One particle layer moving in x–y only (seeds' 2-D beds and kilns): z velocity, z force and x/y rotation are
-    /// held at zero.
-    pub pseudo_2d: bool,
-    /// Particles rotate; `false`: their angular velocities are never updated (inverse moments of inertia zero).
-    pub rotation: bool,
-    pub gravity: Gravity,
-    pub species: SpeciesTable,
-    pub pair_table: PairTable,
-    pub contact_law: ContactLaw,
-    pub walls: Vec<Wall>,
-    /// Neighbour-list skin: candidates are pairs whose surfaces are closer than this.
-    pub skin_m: f64,
-    /// Skin of the force pass's own list when smaller than `skin_m` (the two-level scheme): that list is refiltered
-    /// from the candidates within `skin_m` whenever a particle has moved half of it, and the cells are searched
-    /// again only when the candidates themselves may be incomplete. Equal to `skin_m`: one level.
-    pub inner_skin_m: f64,
-    /// The inner skin was not chosen by the scenario: use two levels only after cell searches where it halves the
-    /// force pass's candidates (otherwise one level until the next search).
-    pub inner_skin_auto: bool,
-    /// Largest tolerated overlap as a fraction of the smaller radius; beyond it the step fails.
-    pub max_overlap_fraction: f64,
-    /// Forces at a distance (liquid bridges, van der Waals, square well); `None`: dry, cohesionless particles.
-    pub cohesion: Option<Cohesion>,
-}
-
-impl SimConfig {
-    /// How far beyond contact the neighbour list must reach for the cohesion model.
-    pub fn reach(&self) -> Reach {
-        self.cohesion.as_ref().map_or(Reach::default(), |c| Reach {
-            pair_gap_m: c.range_m,
-            wall_gap_m: c.wall_range_m,
-        })
-    }
-}
 
 /// Wall-clock time spent per stage.
 #[derive(Debug, Clone, Copy, Default)]

@@ -10,13 +10,13 @@ use std::sync::Arc;
 use rand::RngExt;
 
 use super::ConfigError;
-use super::spec::{BaffleSpec, FillSpec, ScenarioSpec, WallSpec};
+use super::spec::{BaffleSpec, FillSpec, GravitySpec, ScenarioSpec, SpeciesSpec, WallSpec};
 use crate::engine::Vec3;
 use crate::engine::cohesion::Cohesion;
-use crate::engine::geometry::{Domain, RotatingFrame, Wall, WallShape};
+use crate::engine::geometry::{Domain, Gravity, GravityFlip, RotatingFrame, Wall, WallShape};
 use crate::engine::models::cohesion_law::CohesionModel;
 use crate::engine::models::{ContactLaw, NormalModel, PairTable, TangentialModel};
-use crate::engine::particles::{Particles, SpeciesId, SpeciesTable};
+use crate::engine::particles::{Particles, Species, SpeciesId, SpeciesTable};
 use crate::engine::simulation::SimConfig;
 use crate::engine::state::RngState;
 
@@ -114,8 +114,25 @@ pub fn build(spec: ScenarioSpec, path: &Path) -> Result<BuiltScenario, ConfigErr
             return Err(c.fail(key("name"), format!("species name '{}' is used twice", s.name)));
         }
     }
+    if matches!(spec.cohesion, Some(CohesionModel::LiquidBridge(_))) {
+        for (k, s) in spec.species.iter().enumerate() {
+            let key = |f: &str| format!("species[{k}].{f}");
+            if !(s.liquid_content.is_finite() && s.liquid_content >= 0.0) {
+                return Err(c.fail(
+                    key("liquid_content"),
+                    format!("expected a finite value >= 0, got {}", s.liquid_content),
+                ));
+            }
+            if !(s.contact_angle_deg.is_finite() && (0.0..90.0).contains(&s.contact_angle_deg)) {
+                return Err(c.fail(
+                    key("contact_angle_deg"),
+                    format!("expected 0 <= θ < 90 (a wetting liquid), got {}", s.contact_angle_deg),
+                ));
+            }
+        }
+    }
     let species = SpeciesTable {
-        species: spec.species.clone(),
+        species: spec.species.iter().map(engine_species).collect(),
     };
 
     check_contact_law(&c, &spec.contact)?;
@@ -277,7 +294,7 @@ pub fn build(spec: ScenarioSpec, path: &Path) -> Result<BuiltScenario, ConfigErr
         domain,
         pseudo_2d: spec.pseudo_2d,
         rotation: spec.rotation,
-        gravity: spec.gravity,
+        gravity: engine_gravity(&spec.gravity),
         species,
         pair_table,
         contact_law: spec.contact,
@@ -297,6 +314,33 @@ pub fn build(spec: ScenarioSpec, path: &Path) -> Result<BuiltScenario, ConfigErr
         contact_time_s,
         gas,
     })
+}
+
+/// The engine's species from the scenario's: SI units (the contact angle in radians).
+fn engine_species(s: &SpeciesSpec) -> Species {
+    Species {
+        name: s.name.clone(),
+        radius_m: s.radius_m,
+        density_kg_per_m3: s.density_kg_per_m3,
+        youngs_modulus_pa: s.youngs_modulus_pa,
+        poisson_ratio: s.poisson_ratio,
+        friction_coefficient: s.friction_coefficient,
+        yield_force_n: s.yield_force_n,
+        rolling_friction_coefficient: s.rolling_friction_coefficient,
+        contact_angle_rad: s.contact_angle_deg.to_radians(),
+        liquid_content: s.liquid_content,
+    }
+}
+
+/// The engine's gravity from the scenario's.
+fn engine_gravity(g: &GravitySpec) -> Gravity {
+    Gravity {
+        vector_m_per_s2: g.vector_m_per_s2,
+        flip: g.flip.map(|f| GravityFlip {
+            axis: f.axis,
+            frequency_hz: f.frequency_hz,
+        }),
+    }
 }
 
 fn check_contact_law(c: &Checker, law: &ContactLaw) -> Result<(), ConfigError> {

@@ -3,9 +3,8 @@
 
 use serde::{Deserialize, Serialize};
 
-use crate::engine::geometry::Gravity;
+use crate::engine::geometry::Axis;
 use crate::engine::models::ContactLaw;
-use crate::engine::particles::Species;
 
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize, schemars::JsonSchema)]
 #[serde(deny_unknown_fields)]
@@ -22,8 +21,8 @@ pub struct ScenarioSpec {
     /// rotation rates in its slip velocity, eq 6.23, but gives no rotation update).
     #[serde(default = "rotation_default", skip_serializing_if = "rotates")]
     pub rotation: bool,
-    pub gravity: Gravity,
-    pub species: Vec<Species>,
+    pub gravity: GravitySpec,
+    pub species: Vec<SpeciesSpec>,
     pub contact: ContactLaw,
     #[serde(default)]
     pub walls: Vec<WallSpec>,
@@ -50,6 +49,59 @@ pub struct ScenarioSpec {
     /// no particle–sidewall or no particle–distributor cohesion); absent: none.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub cohesion_off: Option<CohesionOff>,
+}
+
+/// A particle material as the scenario writes it (`build.rs` turns it into the engine's `Species`). Walls are
+/// species too.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, schemars::JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct SpeciesSpec {
+    pub name: String,
+    /// Nominal radius of particles created from this species (walls ignore it).
+    pub radius_m: f64,
+    pub density_kg_per_m3: f64,
+    pub youngs_modulus_pa: f64,
+    pub poisson_ratio: f64,
+    /// Coulomb sliding friction coefficient μ.
+    pub friction_coefficient: f64,
+    /// Thornton yield force F_y (seed 000 eq. 2.7; "essentially a fitting parameter"). Only the Thornton normal
+    /// model reads it; `None` means the material never yields.
+    #[serde(default)]
+    pub yield_force_n: Option<f64>,
+    /// Rolling-resistance coefficient μ_r for the optional rolling slot (dimensionless).
+    #[serde(default)]
+    pub rolling_friction_coefficient: f64,
+    /// Reserved for heat transfer: solid conductivity and heat capacity.
+    #[serde(default)]
+    pub thermal_conductivity_w_per_m_k: Option<f64>,
+    #[serde(default)]
+    pub heat_capacity_j_per_kg_k: Option<f64>,
+    /// Contact angle θ of the cohesion model's liquid on this material, degrees (liquid bridges; default 0).
+    #[serde(default)]
+    pub contact_angle_deg: f64,
+    /// Liquid each particle of this species carries at the start, as V̂ = V/R³ (liquid bridges; seed 000 sprays
+    /// up to 0.02; default 0: dry).
+    #[serde(default)]
+    pub liquid_content: f64,
+}
+
+/// Gravity as the scenario writes it.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize, schemars::JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct GravitySpec {
+    pub vector_m_per_s2: [f64; 3],
+    /// One component flips sign periodically (seed 000's zig-zag chute).
+    #[serde(default)]
+    pub flip: Option<GravityFlipSpec>,
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize, schemars::JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct GravityFlipSpec {
+    /// The component that flips sign.
+    pub axis: Axis,
+    /// Flip frequency f: the component keeps its sign for 1/(2f), then reverses.
+    pub frequency_hz: f64,
 }
 
 fn rotation_default() -> bool {

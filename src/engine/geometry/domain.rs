@@ -97,16 +97,13 @@ impl Axis {
 }
 
 /// Gravity, optionally with one component flipping sign as a square wave (seed 000 §3.2, the zig-zag chute).
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize, schemars::JsonSchema)]
-#[serde(deny_unknown_fields)]
+#[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Gravity {
     pub vector_m_per_s2: [f64; 3],
-    #[serde(default)]
     pub flip: Option<GravityFlip>,
 }
 
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize, schemars::JsonSchema)]
-#[serde(deny_unknown_fields)]
+#[derive(Debug, Clone, Copy, PartialEq)]
 pub struct GravityFlip {
     /// The component that flips sign.
     pub axis: Axis,

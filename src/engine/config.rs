@@ -1,0 +1,48 @@
+//! The engine's run configuration: everything about a simulation that does not change while it runs, in SI units
+//! and engine types (built from the scenario by `scenario/build.rs`, which owns every unit conversion). The driver
+//! (`simulation.rs`) holds it behind an `Arc`; kernels read the parts they need.
+
+use super::cohesion::Cohesion;
+use super::geometry::{Domain, Gravity, Wall};
+use super::models::{ContactLaw, PairTable};
+use super::neighbor::Reach;
+use super::particles::SpeciesTable;
+
+/// Everything about a simulation that does not change while it runs.
+#[derive(Debug, Clone)]
+pub struct SimConfig {
+    pub domain: Domain,
+    /// One particle layer moving in x–y only (seeds' 2-D beds and kilns): z velocity, z force and x/y rotation are
+    /// held at zero.
+    pub pseudo_2d: bool,
+    /// Particles rotate; `false`: their angular velocities are never updated (inverse moments of inertia zero).
+    pub rotation: bool,
+    pub gravity: Gravity,
+    pub species: SpeciesTable,
+    pub pair_table: PairTable,
+    pub contact_law: ContactLaw,
+    pub walls: Vec<Wall>,
+    /// Neighbour-list skin: candidates are pairs whose surfaces are closer than this.
+    pub skin_m: f64,
+    /// Skin of the force pass's own list when smaller than `skin_m` (the two-level scheme): that list is refiltered
+    /// from the candidates within `skin_m` whenever a particle has moved half of it, and the cells are searched
+    /// again only when the candidates themselves may be incomplete. Equal to `skin_m`: one level.
+    pub inner_skin_m: f64,
+    /// The inner skin was not chosen by the scenario: use two levels only after cell searches where it halves the
+    /// force pass's candidates (otherwise one level until the next search).
+    pub inner_skin_auto: bool,
+    /// Largest tolerated overlap as a fraction of the smaller radius; beyond it the step fails.
+    pub max_overlap_fraction: f64,
+    /// Forces at a distance (liquid bridges, van der Waals, square well); `None`: dry, cohesionless particles.
+    pub cohesion: Option<Cohesion>,
+}
+
+impl SimConfig {
+    /// How far beyond contact the neighbour list must reach for the cohesion model.
+    pub fn reach(&self) -> Reach {
+        self.cohesion.as_ref().map_or(Reach::default(), |c| Reach {
+            pair_gap_m: c.range_m,
+            wall_gap_m: c.wall_range_m,
+        })
+    }
+}
