@@ -44,7 +44,7 @@ seed: 5
 
 /// Liquid on the particles and in bridges, less what the spray brought.
 fn liquid(state: &SimState) -> f64 {
-    state.particles.liquid_m3.iter().sum::<f64>() + state.cohesion.bridge_liquid_m3()
+    state.particles.liquid_m3.iter().sum::<f64>() + state.contacts.bridge_liquid_m3()
         - state.particles.sprayed_m3.iter().sum::<f64>()
 }
 
@@ -94,8 +94,8 @@ fn b4_liquid_is_conserved_while_bridges_form_and_break() {
         s.particles.len(),
         events.bridges_formed,
         events.bridges_ruptured,
-        s.cohesion.pairs.len() + s.cohesion.walls.len(),
-        s.cohesion.walls.len(),
+        s.contacts.cohesion().pairs.len() + s.contacts.cohesion().walls.len(),
+        s.contacts.cohesion().walls.len(),
         on_b / s.particles.liquid_m3.iter().sum::<f64>()
     );
     assert!(
@@ -103,7 +103,7 @@ fn b4_liquid_is_conserved_while_bridges_form_and_break() {
         "{events:?}"
     );
     assert!(worst < 1e-10, "liquid drifted by {worst:e} of the total");
-    assert!(!s.cohesion.walls.is_empty(), "bridges to the drum stand");
+    assert!(!s.contacts.cohesion().walls.is_empty(), "bridges to the drum stand");
 }
 
 /// Bridges survive the two-level neighbour list's refilters: the wet drum ends with the same bits with the force
@@ -175,8 +175,11 @@ fn a_wet_drum_restarts_bit_identically_on_any_thread_count() {
         "--quiet",
     ]);
     let middle = final_state(&dir.join("split"));
-    assert!(middle.cohesion.pairs.len() > 50, "bridges cross the restart");
-    assert!(!middle.cohesion.walls.is_empty(), "bridges to walls cross the restart");
+    assert!(middle.contacts.cohesion().pairs.len() > 50, "bridges cross the restart");
+    assert!(
+        !middle.contacts.cohesion().walls.is_empty(),
+        "bridges to walls cross the restart"
+    );
     run(&["simulate", "wet.yaml", "--out", "split", "--threads", "1", "--quiet"]);
     let whole = final_state(&dir.join("whole"));
     let split = final_state(&dir.join("split"));
@@ -248,7 +251,7 @@ fn wet_pair_at_rest(cohesion: &str) -> SimState {
     sim.particles.velocity_m_per_s[1].x = -0.005;
     sim.run_steps(200_000).expect("stable");
     let s = sim.snapshot();
-    assert_eq!(s.cohesion.pairs.len(), 1, "one bridge");
+    assert_eq!(s.contacts.cohesion().pairs.len(), 1, "one bridge");
     s
 }
 
@@ -257,7 +260,7 @@ fn wet_pair_at_rest(cohesion: &str) -> SimState {
 #[test]
 fn a_liquid_bridge_holds_two_beads_at_the_hertz_capillary_balance() {
     let s = wet_pair_at_rest("{ liquid_bridge: { surface_tension_n_per_m: 0.072, viscosity_pa_s: 0.01 } }");
-    let volume = s.cohesion.pairs[0].2.bridge_volume_m3;
+    let volume = s.contacts.cohesion().pairs[0].2.bridge_volume_m3;
     // Each bead gave the liquid on its cap facing the other: (L/2)(1 − √(1 − 1/4)) of L = 0.02 R³.
     let expected_volume = 2.0 * 0.5 * 0.02e-9 * (1.0 - 0.75f64.sqrt());
     assert!(
@@ -288,7 +291,7 @@ fn a_young_laplace_bridge_holds_two_beads_at_its_own_balance() {
     let s = wet_pair_at_rest(
         "{ liquid_bridge: { surface_tension_n_per_m: 0.072, viscosity_pa_s: 0.01, capillary_force: young_laplace } }",
     );
-    let volume = s.cohesion.pairs[0].2.bridge_volume_m3;
+    let volume = s.contacts.cohesion().pairs[0].2.bridge_volume_m3;
     let table = granflow::engine::models::capillary_table::CapillaryTable::new(0.001, 0.001, 0.0, 0.0);
     let capillary = table.force_n(volume, 0.0, 0.072);
     let overlap = 0.002 - (s.particles.position_m[0] - s.particles.position_m[1]).norm();
@@ -323,7 +326,7 @@ fn a_bridge_takes_exactly_its_rupture_work_from_an_elastic_pair() {
     let reduced_mass = 0.5 * mass;
     sim.run_steps(30_000).expect("stable");
     let s = sim.snapshot();
-    assert!(s.cohesion.pairs.is_empty(), "the bridge has ruptured");
+    assert!(s.contacts.cohesion().pairs.is_empty(), "the bridge has ruptured");
     assert_eq!(sim.cohesion_events.bridges_formed, 1);
     assert_eq!(sim.cohesion_events.bridges_ruptured, 1);
     // The bridge took the liquid on each bead's facing cap, (L/2)(1 − √(3/4)) of L = 0.02 R³ (see above).
@@ -388,16 +391,16 @@ fn square_well_pairs_escape_or_are_captured_as_the_energy_balance_says() {
         let left = e * e * (approach * approach + energy) - energy;
         println!(
             "square well, a0 = {approach} m/s: separation {separation:e} m, separating at {speed:e} m/s, in well: {}",
-            s.cohesion.pairs.len()
+            s.contacts.cohesion().pairs.len()
         );
         if left > 0.0 {
             let expected = left.sqrt();
             assert!(separation > 0.00202, "escaped");
             assert!((speed / expected - 1.0).abs() < 0.03, "{speed} vs {expected}");
-            assert!(s.cohesion.pairs.is_empty());
+            assert!(s.contacts.cohesion().pairs.is_empty());
         } else {
-            assert_eq!(s.cohesion.pairs.len(), 1, "captured");
-            assert!(s.cohesion.pairs[0].2.in_well);
+            assert_eq!(s.contacts.cohesion().pairs.len(), 1, "captured");
+            assert!(s.contacts.cohesion().pairs[0].2.in_well);
             assert!(separation < 0.002 * 1.01 + 1e-6, "still in the well: {separation}");
         }
     }
@@ -429,7 +432,7 @@ fn bridges_form_only_from_their_start_time() {
     let mut sim = simulation(&built(&bead_on_floor(true, 0.1)), 1);
     sim.run_steps(99_000).expect("stable");
     let before = sim.snapshot();
-    assert!(before.cohesion.walls.is_empty(), "no bridge before 0.1 s");
+    assert!(before.contacts.cohesion().walls.is_empty(), "no bridge before 0.1 s");
     assert!(
         (before.particles.liquid_m3[0] / 0.02e-9 - 1.0).abs() < 1e-14,
         "all the liquid still on the bead"
@@ -440,7 +443,7 @@ fn bridges_form_only_from_their_start_time() {
     );
     sim.run_steps(2_000).expect("stable");
     assert_eq!(
-        sim.snapshot().cohesion.walls.len(),
+        sim.snapshot().contacts.cohesion().walls.len(),
         1,
         "the bridge forms at 0.1 s, in place"
     );
@@ -456,7 +459,7 @@ fn a_wet_bead_bridges_to_the_floor_only_when_wall_bridges_are_on() {
     let mut dry_walls = simulation(&built(&yaml(false)), 1);
     dry_walls.run_steps(50_000).expect("stable");
     assert!(
-        dry_walls.snapshot().cohesion.walls.is_empty(),
+        dry_walls.snapshot().contacts.cohesion().walls.is_empty(),
         "no wall bridge by default"
     );
     let b = built(&yaml(true));
@@ -464,8 +467,8 @@ fn a_wet_bead_bridges_to_the_floor_only_when_wall_bridges_are_on() {
     let mut sim = simulation(&b, 1);
     sim.run_steps(300_000).expect("stable");
     let s = sim.snapshot();
-    assert_eq!(s.cohesion.walls.len(), 1, "one bridge, to the floor");
-    let volume = s.cohesion.walls[0].2.bridge_volume_m3;
+    assert_eq!(s.contacts.cohesion().walls.len(), 1, "one bridge, to the floor");
+    let volume = s.contacts.cohesion().walls[0].2.bridge_volume_m3;
     assert!((volume / (0.5 * liquid) - 1.0).abs() < 1e-12, "{volume}");
     assert!(((s.particles.liquid_m3[0] + volume) / liquid - 1.0).abs() < 1e-12);
     let overlap = 0.001 - s.particles.position_m[0].y;

@@ -59,80 +59,101 @@ pub fn digests(s: &SimState) -> BTreeMap<String, String> {
     d.insert("particles.liquid_m3".into(), floats(&p.liquid_m3));
     d.insert("particles.sprayed_m3".into(), floats(&p.sprayed_m3));
     d.insert("walls.angle_rad".into(), floats(&s.wall_angle_rad));
-    for (table, rows) in [("pairs", &s.contacts.pairs)] {
-        d.insert(
-            format!("contacts.{table}.keys"),
-            digest(rows.iter().flat_map(|(i, j, _)| [i.0 as u64, j.0 as u64])),
-        );
-    }
+    // Contacts: the records of touching pairs; cohesion: the records with a cohesion state (as the engine kept
+    // them in two stores before they became one record per pair).
+    let touching_pairs: Vec<_> = s.contacts.pairs.iter().filter(|(_, _, h)| h.active).collect();
+    let touching_walls: Vec<_> = s.contacts.walls.iter().filter(|(_, _, h)| h.active).collect();
+    d.insert(
+        "contacts.pairs.keys".into(),
+        digest(touching_pairs.iter().flat_map(|(i, j, _)| [i.0 as u64, j.0 as u64])),
+    );
     d.insert(
         "contacts.walls.keys".into(),
-        digest(s.contacts.walls.iter().flat_map(|(i, w, _)| [i.0 as u64, w.0 as u64])),
+        digest(touching_walls.iter().flat_map(|(i, w, _)| [i.0 as u64, w.0 as u64])),
     );
     for (table, histories) in [
-        ("pairs", s.contacts.pairs.iter().map(|(_, _, h)| *h).collect::<Vec<_>>()),
-        ("walls", s.contacts.walls.iter().map(|(_, _, h)| *h).collect::<Vec<_>>()),
+        ("pairs", touching_pairs.iter().map(|(_, _, h)| *h).collect::<Vec<_>>()),
+        ("walls", touching_walls.iter().map(|(_, _, h)| *h).collect::<Vec<_>>()),
     ] {
         d.insert(
             format!("contacts.{table}.flags"),
-            digest(histories.iter().map(|h| (h.active as u64) | ((h.yielded as u64) << 1))),
+            digest(
+                histories
+                    .iter()
+                    .map(|h| (h.active as u64) | ((h.normal.yielded as u64) << 1)),
+            ),
         );
         d.insert(
             format!("contacts.{table}.tangential"),
-            vectors(histories.iter().map(|h| &h.tangential)),
+            vectors(histories.iter().map(|h| &h.tangential.shear)),
         );
         d.insert(
             format!("contacts.{table}.reversal_force_n"),
-            vectors(histories.iter().map(|h| &h.reversal_force_n)),
+            vectors(histories.iter().map(|h| &h.tangential.reversal_force_n)),
         );
         d.insert(
             format!("contacts.{table}.increment_direction"),
-            vectors(histories.iter().map(|h| &h.increment_direction)),
+            vectors(histories.iter().map(|h| &h.tangential.increment_direction)),
         );
         d.insert(
             format!("contacts.{table}.max_overlap_m"),
-            floats(&histories.iter().map(|h| h.max_overlap_m).collect::<Vec<_>>()),
+            floats(&histories.iter().map(|h| h.normal.max_overlap_m).collect::<Vec<_>>()),
         );
         d.insert(
             format!("contacts.{table}.max_normal_force_n"),
-            floats(&histories.iter().map(|h| h.max_normal_force_n).collect::<Vec<_>>()),
+            floats(
+                &histories
+                    .iter()
+                    .map(|h| h.normal.max_normal_force_n)
+                    .collect::<Vec<_>>(),
+            ),
         );
     }
+    let bridged_pairs: Vec<_> = s
+        .contacts
+        .pairs
+        .iter()
+        .filter(|(_, _, h)| !h.cohesion.is_empty())
+        .collect();
+    let bridged_walls: Vec<_> = s
+        .contacts
+        .walls
+        .iter()
+        .filter(|(_, _, h)| !h.cohesion.is_empty())
+        .collect();
     d.insert(
         "cohesion.pairs.keys".into(),
-        digest(s.cohesion.pairs.iter().flat_map(|(i, j, _)| [i.0 as u64, j.0 as u64])),
+        digest(bridged_pairs.iter().flat_map(|(i, j, _)| [i.0 as u64, j.0 as u64])),
     );
     d.insert(
         "cohesion.pairs.bridge_volume_m3".into(),
         floats(
-            &s.cohesion
-                .pairs
+            &bridged_pairs
                 .iter()
-                .map(|(_, _, c)| c.bridge_volume_m3)
+                .map(|(_, _, h)| h.cohesion.bridge_volume_m3)
                 .collect::<Vec<_>>(),
         ),
     );
     d.insert(
         "cohesion.pairs.in_well".into(),
-        digest(s.cohesion.pairs.iter().map(|(_, _, c)| c.in_well as u64)),
+        digest(bridged_pairs.iter().map(|(_, _, h)| h.cohesion.in_well as u64)),
     );
     d.insert(
         "cohesion.walls.keys".into(),
-        digest(s.cohesion.walls.iter().flat_map(|(i, w, _)| [i.0 as u64, w.0 as u64])),
+        digest(bridged_walls.iter().flat_map(|(i, w, _)| [i.0 as u64, w.0 as u64])),
     );
     d.insert(
         "cohesion.walls.bridge_volume_m3".into(),
         floats(
-            &s.cohesion
-                .walls
+            &bridged_walls
                 .iter()
-                .map(|(_, _, c)| c.bridge_volume_m3)
+                .map(|(_, _, h)| h.cohesion.bridge_volume_m3)
                 .collect::<Vec<_>>(),
         ),
     );
     d.insert(
         "cohesion.walls.in_well".into(),
-        digest(s.cohesion.walls.iter().map(|(_, _, c)| c.in_well as u64)),
+        digest(bridged_walls.iter().map(|(_, _, h)| h.cohesion.in_well as u64)),
     );
     if let Some(g) = &s.gas {
         d.insert(
@@ -278,12 +299,12 @@ fn reference_runs_end_in_their_recorded_bits() {
             .contacts
             .pairs
             .iter()
-            .any(|(_, _, h)| h.yielded)
+            .any(|(_, _, h)| h.normal.yielded)
     );
-    assert!(!state("wet-bed-wall-bridges").cohesion.walls.is_empty());
-    assert!(!state("wet-bed-wall-bridges").cohesion.pairs.is_empty());
+    assert!(!state("wet-bed-wall-bridges").contacts.cohesion().walls.is_empty());
+    assert!(!state("wet-bed-wall-bridges").contacts.cohesion().pairs.is_empty());
     assert!(state("seed-001-hamaker").gas.is_some());
-    assert!(!state("seed-001-square-well").cohesion.pairs.is_empty());
+    assert!(!state("seed-001-square-well").contacts.cohesion().pairs.is_empty());
     assert!(
         problems.is_empty(),
         "fields that differ from {REFERENCE}:\n{}",

@@ -88,7 +88,7 @@ fn restart_in_a_fresh_process_is_bit_identical() {
     assert_eq!(whole.step, 3000);
     // The run must exercise what the restart has to carry: yielded Thornton contacts, Walton-Braun history,
     // baffle contacts and a turned drum.
-    let yielded = whole.contacts.pairs.iter().filter(|c| c.2.yielded).count();
+    let yielded = whole.contacts.pairs.iter().filter(|c| c.2.normal.yielded).count();
     let baffle_contacts = whole.contacts.walls.iter().filter(|c| c.1.0 >= 1).count();
     println!(
         "restart: {} pair contacts ({yielded} yielded), {} wall contacts ({baffle_contacts} on baffles), drum angle {:.3} rad",

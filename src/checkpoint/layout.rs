@@ -21,10 +21,10 @@ use xxhash_rust::xxh3::Xxh3Default;
 
 use super::{CheckpointError, CheckpointMeta};
 use crate::engine::Vec3;
-use crate::engine::cohesion::{CohesionState, CohesionStore};
 use crate::engine::contacts::{ContactStore, WallId};
 use crate::engine::gas::coupled::{GasSnapshot, GasStepStats};
 use crate::engine::models::ContactHistory;
+use crate::engine::models::history::{FieldKind, FieldValue, HISTORY_FIELDS, HistoryField};
 use crate::engine::net_force::NetForceTally;
 use crate::engine::particles::{ParticleId, Particles, SpeciesId};
 use crate::engine::state::{RngState, SimState};
@@ -37,9 +37,9 @@ pub(crate) const FORMAT_NAME: &str = "granflow-checkpoint";
 pub(crate) enum Rows {
     /// N, the number of particles.
     Particles,
-    /// The number of particle–particle contacts.
+    /// The number of particle–particle history records (active contacts and pairs with a cohesion state).
     PairContacts,
-    /// The number of particle–wall contacts.
+    /// The number of particle–wall history records.
     WallContacts,
     /// The number of walls.
     Walls,
@@ -53,10 +53,6 @@ pub(crate) enum Rows {
     GasFaces(u8),
     /// One value with a gas, none without (a 1-D dataset of length 0 or 1).
     GasScalar,
-    /// The number of particle pairs with a cohesion state (a liquid bridge or a square well).
-    CohesionPairs,
-    /// The number of particle–wall pairs with a cohesion state.
-    CohesionWalls,
     /// One row when the run sums net forces by mechanism, none otherwise.
     NetForce,
     /// The number of walls when the run sums net forces by mechanism, 0 otherwise.
@@ -129,6 +125,10 @@ macro_rules! datasets {
         #[derive(Debug, Clone, Default, PartialEq)]
         pub(crate) struct Arrays {
             $( pub $field: Vec<$ty>, )*
+            /// The history fields of the pair records and of the wall records (`models::history`), visited after
+            /// the table's datasets.
+            pub pair_history: HistoryArrays,
+            pub wall_history: HistoryArrays,
         }
 
         /// Every dataset of the layout, in checksum order.
@@ -143,30 +143,164 @@ macro_rules! datasets {
         )*];
 
         impl Arrays {
-            /// Calls `v` on every dataset in table order.
+            /// Calls `v` on every dataset in table order, then on the history datasets.
             pub(crate) fn visit<V: Visitor>(&self, v: &mut V) -> Result<(), V::Error> {
                 let mut specs = DATASETS.iter();
                 $(
                     let spec = specs.next().expect("DATASETS has one entry per field");
                     v.visit(spec, &self.$field)?;
                 )*
-                Ok(())
+                self.pair_history.visit(HistoryTable::Pairs, v)?;
+                self.wall_history.visit(HistoryTable::Walls, v)
             }
 
-            /// Calls `v` on every dataset in table order, letting it fill the arrays.
+            /// Calls `v` on every dataset in table order, then on the history datasets, letting it fill the arrays.
             pub(crate) fn visit_mut<V: VisitorMut>(&mut self, v: &mut V) -> Result<(), V::Error> {
                 let mut specs = DATASETS.iter();
                 $(
                     let spec = specs.next().expect("DATASETS has one entry per field");
                     v.visit(spec, &mut self.$field)?;
                 )*
-                Ok(())
+                self.pair_history.visit_mut(HistoryTable::Pairs, v)?;
+                self.wall_history.visit_mut(HistoryTable::Walls, v)
             }
         }
     };
 }
 
-const TANGENTIAL_UNITS: &str = "m (linear_spring_coulomb, mindlin: displacement) or N (walton_braun: force)";
+/// The two tables of history records.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum HistoryTable {
+    Pairs,
+    Walls,
+}
+
+impl HistoryTable {
+    /// The dataset of `field` in this table.
+    pub(crate) fn spec(self, field: &HistoryField) -> DatasetSpec {
+        let (path, rows) = match self {
+            HistoryTable::Pairs => (field.pair_path, Rows::PairContacts),
+            HistoryTable::Walls => (field.wall_path, Rows::WallContacts),
+        };
+        let (width, dtype) = match field.kind {
+            FieldKind::Flag => (1, <u8 as Element>::NAME),
+            FieldKind::Scalar => (1, <f64 as Element>::NAME),
+            FieldKind::Vector => (3, <f64 as Element>::NAME),
+        };
+        DatasetSpec {
+            path,
+            rows,
+            width,
+            units: field.units,
+            dtype,
+        }
+    }
+}
+
+/// Every dataset of a checkpoint: the table's, then the history fields' of pairs and of walls.
+#[cfg(test)]
+pub(crate) fn all_datasets() -> Vec<DatasetSpec> {
+    let history = |t: HistoryTable| HISTORY_FIELDS.iter().map(move |f| t.spec(f));
+    DATASETS
+        .iter()
+        .copied()
+        .chain(history(HistoryTable::Pairs))
+        .chain(history(HistoryTable::Walls))
+        .collect()
+}
+
+/// One history field's column: flags as u8, scalars and vectors (three per row) as f64.
+#[derive(Debug, Clone, PartialEq)]
+pub(crate) enum HistoryColumn {
+    Flags(Vec<u8>),
+    Values(Vec<f64>),
+}
+
+/// The history columns of one table of records, one per entry of `HISTORY_FIELDS`, in its order.
+#[derive(Debug, Clone, PartialEq)]
+pub(crate) struct HistoryArrays {
+    pub columns: Vec<HistoryColumn>,
+}
+
+impl Default for HistoryArrays {
+    fn default() -> Self {
+        HistoryArrays {
+            columns: HISTORY_FIELDS
+                .iter()
+                .map(|f| match f.kind {
+                    FieldKind::Flag => HistoryColumn::Flags(Vec::new()),
+                    FieldKind::Scalar | FieldKind::Vector => HistoryColumn::Values(Vec::new()),
+                })
+                .collect(),
+        }
+    }
+}
+
+impl HistoryArrays {
+    /// The columns of `records`.
+    fn of<'a>(records: impl Iterator<Item = &'a ContactHistory>) -> HistoryArrays {
+        let mut out = HistoryArrays::default();
+        for h in records {
+            for (field, column) in HISTORY_FIELDS.iter().zip(&mut out.columns) {
+                match ((field.get)(h), column) {
+                    (FieldValue::Flag(b), HistoryColumn::Flags(c)) => c.push(u8::from(b)),
+                    (FieldValue::Scalar(x), HistoryColumn::Values(c)) => c.push(x),
+                    (FieldValue::Vector(x), HistoryColumn::Values(c)) => c.extend_from_slice(&[x.x, x.y, x.z]),
+                    _ => unreachable!("a column has its field's kind"),
+                }
+            }
+        }
+        out
+    }
+
+    /// Sets every field of `h` from row `k`. The arrays must have passed [`Arrays::check`].
+    fn fill(&self, k: usize, h: &mut ContactHistory) {
+        for (field, column) in HISTORY_FIELDS.iter().zip(&self.columns) {
+            let value = match (field.kind, column) {
+                (FieldKind::Flag, HistoryColumn::Flags(c)) => FieldValue::Flag(c[k] != 0),
+                (FieldKind::Scalar, HistoryColumn::Values(c)) => FieldValue::Scalar(c[k]),
+                (FieldKind::Vector, HistoryColumn::Values(c)) => {
+                    FieldValue::Vector(Vec3::new(c[3 * k], c[3 * k + 1], c[3 * k + 2]))
+                }
+                _ => unreachable!("a column has its field's kind"),
+            };
+            (field.set)(h, value);
+        }
+    }
+
+    /// The first flag that is neither 0 nor 1, as (dataset path, row, value).
+    fn bad_flag(&self, table: HistoryTable) -> Option<(&'static str, usize, u8)> {
+        HISTORY_FIELDS
+            .iter()
+            .zip(&self.columns)
+            .find_map(|(field, column)| match column {
+                HistoryColumn::Flags(c) => c.iter().position(|&v| v > 1).map(|k| (table.spec(field).path, k, c[k])),
+                HistoryColumn::Values(_) => None,
+            })
+    }
+
+    fn visit<V: Visitor>(&self, table: HistoryTable, v: &mut V) -> Result<(), V::Error> {
+        for (field, column) in HISTORY_FIELDS.iter().zip(&self.columns) {
+            let spec = table.spec(field);
+            match column {
+                HistoryColumn::Flags(c) => v.visit(&spec, c)?,
+                HistoryColumn::Values(c) => v.visit(&spec, c)?,
+            }
+        }
+        Ok(())
+    }
+
+    fn visit_mut<V: VisitorMut>(&mut self, table: HistoryTable, v: &mut V) -> Result<(), V::Error> {
+        for (field, column) in HISTORY_FIELDS.iter().zip(&mut self.columns) {
+            let spec = table.spec(field);
+            match column {
+                HistoryColumn::Flags(c) => v.visit(&spec, c)?,
+                HistoryColumn::Values(c) => v.visit(&spec, c)?,
+            }
+        }
+        Ok(())
+    }
+}
 
 datasets! {
     particle_id: u32 => "particles/id", Rows::Particles, 1, "1";
@@ -183,22 +317,10 @@ datasets! {
     pair_i: u32 => "contacts/pairs/i", Rows::PairContacts, 1, "1";
     pair_j: u32 => "contacts/pairs/j", Rows::PairContacts, 1, "1";
     pair_active: u8 => "contacts/pairs/active", Rows::PairContacts, 1, "1";
-    pair_yielded: u8 => "contacts/pairs/yielded", Rows::PairContacts, 1, "1";
-    pair_tangential: f64 => "contacts/pairs/tangential", Rows::PairContacts, 3, TANGENTIAL_UNITS;
-    pair_reversal_force_n: f64 => "contacts/pairs/reversal_force_n", Rows::PairContacts, 3, "N";
-    pair_increment_direction: f64 => "contacts/pairs/increment_direction", Rows::PairContacts, 3, "1";
-    pair_max_overlap_m: f64 => "contacts/pairs/max_overlap_m", Rows::PairContacts, 1, "m";
-    pair_max_normal_force_n: f64 => "contacts/pairs/max_normal_force_n", Rows::PairContacts, 1, "N";
 
     wall_i: u32 => "contacts/walls/i", Rows::WallContacts, 1, "1";
     wall_wall: u16 => "contacts/walls/wall", Rows::WallContacts, 1, "1";
     wall_active: u8 => "contacts/walls/active", Rows::WallContacts, 1, "1";
-    wall_yielded: u8 => "contacts/walls/yielded", Rows::WallContacts, 1, "1";
-    wall_tangential: f64 => "contacts/walls/tangential", Rows::WallContacts, 3, TANGENTIAL_UNITS;
-    wall_reversal_force_n: f64 => "contacts/walls/reversal_force_n", Rows::WallContacts, 3, "N";
-    wall_increment_direction: f64 => "contacts/walls/increment_direction", Rows::WallContacts, 3, "1";
-    wall_max_overlap_m: f64 => "contacts/walls/max_overlap_m", Rows::WallContacts, 1, "m";
-    wall_max_normal_force_n: f64 => "contacts/walls/max_normal_force_n", Rows::WallContacts, 1, "N";
 
     wall_angle_rad: f64 => "walls/angle_rad", Rows::Walls, 1, "rad";
 
@@ -230,14 +352,6 @@ datasets! {
 
     liquid_m3: f64 => "particles/liquid_m3", Rows::Particles, 1, "m3";
     sprayed_m3: f64 => "particles/sprayed_m3", Rows::Particles, 1, "m3";
-    cohesion_pair_i: u32 => "cohesion/pairs/i", Rows::CohesionPairs, 1, "1";
-    cohesion_pair_j: u32 => "cohesion/pairs/j", Rows::CohesionPairs, 1, "1";
-    cohesion_pair_bridge_volume_m3: f64 => "cohesion/pairs/bridge_volume_m3", Rows::CohesionPairs, 1, "m3";
-    cohesion_pair_in_well: u8 => "cohesion/pairs/in_well", Rows::CohesionPairs, 1, "1";
-    cohesion_wall_i: u32 => "cohesion/walls/i", Rows::CohesionWalls, 1, "1";
-    cohesion_wall_wall: u16 => "cohesion/walls/wall", Rows::CohesionWalls, 1, "1";
-    cohesion_wall_bridge_volume_m3: f64 => "cohesion/walls/bridge_volume_m3", Rows::CohesionWalls, 1, "m3";
-    cohesion_wall_in_well: u8 => "cohesion/walls/in_well", Rows::CohesionWalls, 1, "1";
 
     net_force_steps: u64 => "net_force/steps", Rows::NetForce, 1, "1";
     net_force_fluid_n: f64 => "net_force/fluid_sum_n", Rows::NetForce, 3, "N";
@@ -255,9 +369,6 @@ pub(crate) const GROUPS: &[&str] = &[
     "rng",
     "gas",
     "gas/last_step",
-    "cohesion",
-    "cohesion/pairs",
-    "cohesion/walls",
     "net_force",
 ];
 
@@ -279,73 +390,11 @@ fn unflatten(v: &[f64]) -> Vec<Vec3> {
     v.chunks_exact(3).map(|c| Vec3::new(c[0], c[1], c[2])).collect()
 }
 
-/// The history columns of one contact table, filled by [`HistoryColumns::push`].
-#[derive(Default)]
-struct HistoryColumns {
-    active: Vec<u8>,
-    yielded: Vec<u8>,
-    tangential: Vec<f64>,
-    reversal_force_n: Vec<f64>,
-    increment_direction: Vec<f64>,
-    max_overlap_m: Vec<f64>,
-    max_normal_force_n: Vec<f64>,
-}
-
-impl HistoryColumns {
-    fn push(&mut self, h: &ContactHistory) {
-        self.active.push(u8::from(h.active));
-        self.yielded.push(u8::from(h.yielded));
-        self.tangential
-            .extend_from_slice(&[h.tangential.x, h.tangential.y, h.tangential.z]);
-        self.reversal_force_n
-            .extend_from_slice(&[h.reversal_force_n.x, h.reversal_force_n.y, h.reversal_force_n.z]);
-        self.increment_direction.extend_from_slice(&[
-            h.increment_direction.x,
-            h.increment_direction.y,
-            h.increment_direction.z,
-        ]);
-        self.max_overlap_m.push(h.max_overlap_m);
-        self.max_normal_force_n.push(h.max_normal_force_n);
-    }
-}
-
-/// The history of row `k` of a contact table. The arrays must have passed [`Arrays::check`].
-#[allow(clippy::too_many_arguments)]
-fn history_at(
-    k: usize,
-    active: &[u8],
-    yielded: &[u8],
-    tangential: &[f64],
-    reversal: &[f64],
-    direction: &[f64],
-    max_overlap: &[f64],
-    max_force: &[f64],
-) -> ContactHistory {
-    let v = |a: &[f64]| Vec3::new(a[3 * k], a[3 * k + 1], a[3 * k + 2]);
-    ContactHistory {
-        active: active[k] != 0,
-        yielded: yielded[k] != 0,
-        tangential: v(tangential),
-        reversal_force_n: v(reversal),
-        increment_direction: v(direction),
-        max_overlap_m: max_overlap[k],
-        max_normal_force_n: max_force[k],
-    }
-}
-
 impl Arrays {
     /// The datasets of `state`. Call [`Arrays::check`] on the result before writing it.
     pub(crate) fn from_state(state: &SimState) -> Arrays {
         let p = &state.particles;
         let gas = state.gas.as_ref();
-        let mut pairs = HistoryColumns::default();
-        for (_, _, h) in &state.contacts.pairs {
-            pairs.push(h);
-        }
-        let mut walls = HistoryColumns::default();
-        for (_, _, h) in &state.contacts.walls {
-            walls.push(h);
-        }
         Arrays {
             particle_id: p.id.iter().map(|id| id.0).collect(),
             particle_species: p.species.iter().map(|s| s.0).collect(),
@@ -360,23 +409,21 @@ impl Arrays {
 
             pair_i: state.contacts.pairs.iter().map(|(i, _, _)| i.0).collect(),
             pair_j: state.contacts.pairs.iter().map(|(_, j, _)| j.0).collect(),
-            pair_active: pairs.active,
-            pair_yielded: pairs.yielded,
-            pair_tangential: pairs.tangential,
-            pair_reversal_force_n: pairs.reversal_force_n,
-            pair_increment_direction: pairs.increment_direction,
-            pair_max_overlap_m: pairs.max_overlap_m,
-            pair_max_normal_force_n: pairs.max_normal_force_n,
+            pair_active: state
+                .contacts
+                .pairs
+                .iter()
+                .map(|(_, _, h)| u8::from(h.active))
+                .collect(),
 
             wall_i: state.contacts.walls.iter().map(|(i, _, _)| i.0).collect(),
             wall_wall: state.contacts.walls.iter().map(|(_, w, _)| w.0).collect(),
-            wall_active: walls.active,
-            wall_yielded: walls.yielded,
-            wall_tangential: walls.tangential,
-            wall_reversal_force_n: walls.reversal_force_n,
-            wall_increment_direction: walls.increment_direction,
-            wall_max_overlap_m: walls.max_overlap_m,
-            wall_max_normal_force_n: walls.max_normal_force_n,
+            wall_active: state
+                .contacts
+                .walls
+                .iter()
+                .map(|(_, _, h)| u8::from(h.active))
+                .collect(),
 
             wall_angle_rad: state.wall_angle_rad.clone(),
 
@@ -408,34 +455,6 @@ impl Arrays {
 
             liquid_m3: p.liquid_m3.clone(),
             sprayed_m3: p.sprayed_m3.clone(),
-            cohesion_pair_i: state.cohesion.pairs.iter().map(|(i, _, _)| i.0).collect(),
-            cohesion_pair_j: state.cohesion.pairs.iter().map(|(_, j, _)| j.0).collect(),
-            cohesion_pair_bridge_volume_m3: state
-                .cohesion
-                .pairs
-                .iter()
-                .map(|(_, _, c)| c.bridge_volume_m3)
-                .collect(),
-            cohesion_pair_in_well: state
-                .cohesion
-                .pairs
-                .iter()
-                .map(|(_, _, c)| u8::from(c.in_well))
-                .collect(),
-            cohesion_wall_i: state.cohesion.walls.iter().map(|(i, _, _)| i.0).collect(),
-            cohesion_wall_wall: state.cohesion.walls.iter().map(|(_, w, _)| w.0).collect(),
-            cohesion_wall_bridge_volume_m3: state
-                .cohesion
-                .walls
-                .iter()
-                .map(|(_, _, c)| c.bridge_volume_m3)
-                .collect(),
-            cohesion_wall_in_well: state
-                .cohesion
-                .walls
-                .iter()
-                .map(|(_, _, c)| u8::from(c.in_well))
-                .collect(),
 
             net_force_steps: state.net_force.as_ref().map(|t| t.steps).into_iter().collect(),
             net_force_fluid_n: state
@@ -453,6 +472,9 @@ impl Arrays {
                 .as_ref()
                 .map(|t| flatten(&t.wall_cohesion_n))
                 .unwrap_or_default(),
+
+            pair_history: HistoryArrays::of(state.contacts.pairs.iter().map(|(_, _, h)| h)),
+            wall_history: HistoryArrays::of(state.contacts.walls.iter().map(|(_, _, h)| h)),
         }
     }
 
@@ -466,24 +488,25 @@ impl Arrays {
         let n_walls = self.wall_angle_rad.len();
         let flags = [
             ("contacts/pairs/active", &self.pair_active),
-            ("contacts/pairs/yielded", &self.pair_yielded),
             ("contacts/walls/active", &self.wall_active),
-            ("contacts/walls/yielded", &self.wall_yielded),
-            ("cohesion/pairs/in_well", &self.cohesion_pair_in_well),
-            ("cohesion/walls/in_well", &self.cohesion_wall_in_well),
         ];
         for (path, values) in flags {
             if let Some(k) = values.iter().position(|&v| v > 1) {
                 return Err(format!("/{path}[{k}] is {}, expected 0 or 1", values[k]));
             }
         }
+        for (arrays, table) in [
+            (&self.pair_history, HistoryTable::Pairs),
+            (&self.wall_history, HistoryTable::Walls),
+        ] {
+            if let Some((path, k, v)) = arrays.bad_flag(table) {
+                return Err(format!("/{path}[{k}] is {v}, expected 0 or 1"));
+            }
+        }
         let particles = [
             ("contacts/pairs/i", &self.pair_i),
             ("contacts/pairs/j", &self.pair_j),
             ("contacts/walls/i", &self.wall_i),
-            ("cohesion/pairs/i", &self.cohesion_pair_i),
-            ("cohesion/pairs/j", &self.cohesion_pair_j),
-            ("cohesion/walls/i", &self.cohesion_wall_i),
         ];
         for (path, values) in particles {
             if let Some(k) = values.iter().position(|&v| v as usize >= n) {
@@ -518,10 +541,7 @@ impl Arrays {
         if let Some(&v) = self.gas_last_converged.first().filter(|&&v| v > 1) {
             return Err(format!("/gas/last_step/converged is {v}, expected 0 or 1"));
         }
-        for (path, values) in [
-            ("contacts/walls/wall", &self.wall_wall),
-            ("cohesion/walls/wall", &self.cohesion_wall_wall),
-        ] {
+        for (path, values) in [("contacts/walls/wall", &self.wall_wall)] {
             if let Some(k) = values.iter().position(|&w| w as usize >= n_walls) {
                 return Err(format!(
                     "/{path}[{k}] = {} is not a wall (there are {n_walls})",
@@ -548,58 +568,30 @@ impl Arrays {
             liquid_m3: self.liquid_m3,
             sprayed_m3: self.sprayed_m3,
         };
-        let state_at = |volume: &[f64], in_well: &[u8], k: usize| CohesionState {
-            bridge_volume_m3: volume[k],
-            in_well: in_well[k] == 1,
-        };
-        let cohesion = CohesionStore {
-            pairs: (0..self.cohesion_pair_i.len())
-                .map(|k| {
-                    (
-                        ParticleId(self.cohesion_pair_i[k]),
-                        ParticleId(self.cohesion_pair_j[k]),
-                        state_at(&self.cohesion_pair_bridge_volume_m3, &self.cohesion_pair_in_well, k),
-                    )
-                })
-                .collect(),
-            walls: (0..self.cohesion_wall_i.len())
-                .map(|k| {
-                    (
-                        ParticleId(self.cohesion_wall_i[k]),
-                        WallId(self.cohesion_wall_wall[k]),
-                        state_at(&self.cohesion_wall_bridge_volume_m3, &self.cohesion_wall_in_well, k),
-                    )
-                })
-                .collect(),
+        let record = |active: u8, history: &HistoryArrays, k: usize| {
+            let mut h = ContactHistory {
+                active: active != 0,
+                ..ContactHistory::INACTIVE
+            };
+            history.fill(k, &mut h);
+            h
         };
         let pairs = (0..self.pair_i.len())
             .map(|k| {
-                let h = history_at(
-                    k,
-                    &self.pair_active,
-                    &self.pair_yielded,
-                    &self.pair_tangential,
-                    &self.pair_reversal_force_n,
-                    &self.pair_increment_direction,
-                    &self.pair_max_overlap_m,
-                    &self.pair_max_normal_force_n,
-                );
-                (ParticleId(self.pair_i[k]), ParticleId(self.pair_j[k]), h)
+                (
+                    ParticleId(self.pair_i[k]),
+                    ParticleId(self.pair_j[k]),
+                    record(self.pair_active[k], &self.pair_history, k),
+                )
             })
             .collect();
         let walls = (0..self.wall_i.len())
             .map(|k| {
-                let h = history_at(
-                    k,
-                    &self.wall_active,
-                    &self.wall_yielded,
-                    &self.wall_tangential,
-                    &self.wall_reversal_force_n,
-                    &self.wall_increment_direction,
-                    &self.wall_max_overlap_m,
-                    &self.wall_max_normal_force_n,
-                );
-                (ParticleId(self.wall_i[k]), WallId(self.wall_wall[k]), h)
+                (
+                    ParticleId(self.wall_i[k]),
+                    WallId(self.wall_wall[k]),
+                    record(self.wall_active[k], &self.wall_history, k),
+                )
             })
             .collect();
         let mut seed = [0u8; 32];
@@ -636,7 +628,6 @@ impl Arrays {
             particles,
             wall_angle_rad: self.wall_angle_rad,
             contacts: ContactStore { pairs, walls },
-            cohesion,
             rng: RngState {
                 seed,
                 stream: self.rng_stream[0],

@@ -31,7 +31,7 @@ use crate::engine::SimState;
 
 /// Version of the file layout. Bump it whenever a name, type, shape or the checksum definition changes; readers
 /// reject any other version with [`CheckpointError::Version`].
-pub const CHECKPOINT_FORMAT_VERSION: u32 = 4;
+pub const CHECKPOINT_FORMAT_VERSION: u32 = 5;
 
 /// Metadata stored beside the state.
 #[derive(Debug, Clone, PartialEq)]
@@ -410,8 +410,6 @@ fn expected_shape(spec: &DatasetSpec) -> String {
         Rows::GasCells => "gas cells".to_string(),
         Rows::GasFaces(a) => format!("gas faces normal to axis {a}"),
         Rows::GasScalar => "0 or 1".to_string(),
-        Rows::CohesionPairs => "cohesion pairs".to_string(),
-        Rows::CohesionWalls => "cohesion wall pairs".to_string(),
         Rows::NetForce => "0 or 1".to_string(),
         Rows::NetForceWalls => "0 or walls".to_string(),
     };
@@ -426,9 +424,9 @@ fn expected_shape(spec: &DatasetSpec) -> String {
 mod tests {
     use super::*;
     use crate::engine::Vec3;
-    use crate::engine::cohesion::{CohesionState, CohesionStore};
     use crate::engine::contacts::{ContactStore, WallId};
     use crate::engine::models::ContactHistory;
+    use crate::engine::models::history::{CohesionHistory, NormalHistory, TangentialHistory};
     use crate::engine::particles::{ParticleId, Particles, SpeciesId};
     use crate::engine::state::RngState;
 
@@ -443,12 +441,31 @@ mod tests {
     fn history(k: f64, yielded: bool) -> ContactHistory {
         ContactHistory {
             active: true,
-            yielded,
-            tangential: v(1.1e-7 * k, -2.3e-8 * k, -0.0),
-            reversal_force_n: v(0.31 * k, 1.7e-3, -4.9e-2 * k),
-            increment_direction: v(0.6, -0.8 * k / k.abs(), SUBNORMAL),
-            max_overlap_m: 3.3e-6 * k,
-            max_normal_force_n: 12.75 + k,
+            normal: NormalHistory {
+                yielded,
+                max_overlap_m: 3.3e-6 * k,
+                max_normal_force_n: 12.75 + k,
+            },
+            tangential: TangentialHistory {
+                shear: v(1.1e-7 * k, -2.3e-8 * k, -0.0),
+                reversal_force_n: v(0.31 * k, 1.7e-3, -4.9e-2 * k),
+                increment_direction: v(0.6, -0.8 * k / k.abs(), SUBNORMAL),
+            },
+            cohesion: CohesionHistory {
+                bridge_volume_m3: 1.5e-13 * k.abs(),
+                in_well: k > 0.0,
+            },
+        }
+    }
+
+    /// A record with a cohesion state only (a bridge or well at a gap).
+    fn cohesion_only(bridge_volume_m3: f64, in_well: bool) -> ContactHistory {
+        ContactHistory {
+            cohesion: CohesionHistory {
+                bridge_volume_m3,
+                in_well,
+            },
+            ..ContactHistory::INACTIVE
         }
     }
 
@@ -474,11 +491,14 @@ mod tests {
         let contacts = ContactStore {
             pairs: vec![
                 (ParticleId(0), ParticleId(1), history(1.0, false)),
+                (ParticleId(0), ParticleId(2), cohesion_only(2.5e-13, false)),
                 (ParticleId(0), ParticleId(3), history(-2.0, true)),
                 (ParticleId(2), ParticleId(4), history(3.5, false)),
+                (ParticleId(3), ParticleId(4), cohesion_only(0.0, true)),
             ],
             walls: vec![
                 (ParticleId(1), WallId(0), history(-0.5, true)),
+                (ParticleId(1), WallId(1), cohesion_only(0.0, true)),
                 (ParticleId(3), WallId(1), history(7.25, false)),
             ],
         };
@@ -493,34 +513,6 @@ mod tests {
             particles: p,
             wall_angle_rad: vec![0.25, -1.5e-7],
             contacts,
-            cohesion: CohesionStore {
-                pairs: vec![
-                    (
-                        ParticleId(0),
-                        ParticleId(2),
-                        CohesionState {
-                            bridge_volume_m3: 2.5e-13,
-                            in_well: false,
-                        },
-                    ),
-                    (
-                        ParticleId(3),
-                        ParticleId(4),
-                        CohesionState {
-                            bridge_volume_m3: 0.0,
-                            in_well: true,
-                        },
-                    ),
-                ],
-                walls: vec![(
-                    ParticleId(1),
-                    WallId(1),
-                    CohesionState {
-                        bridge_volume_m3: 0.0,
-                        in_well: true,
-                    },
-                )],
-            },
             rng: RngState {
                 seed,
                 stream: 0xdead_beef_1234_5678,
@@ -611,19 +603,23 @@ mod tests {
         let diff = crate::engine::state::first_difference(&a, &b).expect("differs");
         assert!(diff.starts_with("particles.velocity_m_per_s[0].x"), "{diff}");
         let mut c = a.clone();
-        c.contacts.walls[1].2.max_overlap_m += 1e-20;
+        c.contacts.walls[2].2.normal.max_overlap_m += 1e-20;
         let diff = crate::engine::state::first_difference(&a, &c).expect("differs");
         assert!(
-            diff.starts_with("contacts.walls[1]") && diff.contains("max_overlap_m"),
+            diff.starts_with("contacts.walls[2]") && diff.contains("normal.max_overlap_m"),
             "{diff}"
         );
+        // Every field of the table is compared (here the cohesion slot's, last in the record).
+        let mut d = a.clone();
+        d.contacts.pairs[1].2.cohesion.bridge_volume_m3 *= 1.0 + f64::EPSILON;
+        let diff = crate::engine::state::first_difference(&a, &d).expect("differs");
+        assert!(diff.contains("cohesion.bridge_volume_m3"), "{diff}");
     }
 
     #[test]
     fn empty_contacts_and_no_walls_round_trip() {
         let mut state = sample_state();
         state.contacts = ContactStore::default();
-        state.cohesion.walls.clear();
         state.wall_angle_rad.clear();
         if let Some(tally) = state.net_force.as_mut() {
             tally.wall_contact_n.clear();
@@ -651,7 +647,6 @@ mod tests {
         let mut state = sample_state();
         state.particles = Particles::default();
         state.contacts = ContactStore::default();
-        state.cohesion = CohesionStore::default();
         round_trip(&state, &sample_meta());
     }
 
@@ -992,49 +987,13 @@ mod tests {
                 state.contacts.walls.iter().map(|c| c.2).collect(),
             ),
         ];
-        for (table, i, partner, h) in tables {
+        for (table, i, partner, h) in &tables {
             let m = h.len();
-            let partner_name = if table == "pairs" { "j" } else { "wall" };
-            let flag = |get: fn(&ContactHistory) -> bool| -> Vec<u8> { h.iter().map(|x| u8::from(get(x))).collect() };
-            let vec = |get: fn(&ContactHistory) -> Vec3| v3(&h.iter().map(get).collect::<Vec<_>>());
-            let scalar = |get: fn(&ContactHistory) -> f64| f(h.iter().map(get));
-            ds(&mut b, &format!("contacts/{table}/i"), &[m], &i);
-            ds(&mut b, &format!("contacts/{table}/{partner_name}"), &[m], &partner);
-            ds(&mut b, &format!("contacts/{table}/active"), &[m], &flag(|x| x.active));
-            ds(&mut b, &format!("contacts/{table}/yielded"), &[m], &flag(|x| x.yielded));
-            ds(
-                &mut b,
-                &format!("contacts/{table}/tangential"),
-                &[m, 3],
-                &vec(|x| x.tangential),
-            );
-            let reversal = vec(|x| x.reversal_force_n);
-            ds(
-                &mut b,
-                &format!("contacts/{table}/reversal_force_n"),
-                &[m, 3],
-                &reversal,
-            );
-            let direction = vec(|x| x.increment_direction);
-            ds(
-                &mut b,
-                &format!("contacts/{table}/increment_direction"),
-                &[m, 3],
-                &direction,
-            );
-            ds(
-                &mut b,
-                &format!("contacts/{table}/max_overlap_m"),
-                &[m],
-                &scalar(|x| x.max_overlap_m),
-            );
-            let max_force = scalar(|x| x.max_normal_force_n);
-            ds(
-                &mut b,
-                &format!("contacts/{table}/max_normal_force_n"),
-                &[m],
-                &max_force,
-            );
+            let partner_name = if *table == "pairs" { "j" } else { "wall" };
+            let active: Vec<u8> = h.iter().map(|x| u8::from(x.active)).collect();
+            ds(&mut b, &format!("contacts/{table}/i"), &[m], i);
+            ds(&mut b, &format!("contacts/{table}/{partner_name}"), &[m], partner);
+            ds(&mut b, &format!("contacts/{table}/active"), &[m], &active);
         }
         let walls = state.wall_angle_rad.len();
         ds(
@@ -1134,31 +1093,6 @@ mod tests {
         ds(&mut b, "gas/last_step/converged", &[1], &[u8::from(gas.last.converged)]);
         ds(&mut b, "particles/liquid_m3", &[n], &f(p.liquid_m3.iter().copied()));
         ds(&mut b, "particles/sprayed_m3", &[n], &f(p.sprayed_m3.iter().copied()));
-        type CohesionTable = (&'static str, Vec<u8>, Vec<u8>, Vec<CohesionState>);
-        let cohesion: [CohesionTable; 2] = [
-            (
-                "pairs",
-                state.cohesion.pairs.iter().flat_map(|c| c.0.0.to_le_bytes()).collect(),
-                state.cohesion.pairs.iter().flat_map(|c| c.1.0.to_le_bytes()).collect(),
-                state.cohesion.pairs.iter().map(|c| c.2).collect(),
-            ),
-            (
-                "walls",
-                state.cohesion.walls.iter().flat_map(|c| c.0.0.to_le_bytes()).collect(),
-                state.cohesion.walls.iter().flat_map(|c| c.1.0.to_le_bytes()).collect(),
-                state.cohesion.walls.iter().map(|c| c.2).collect(),
-            ),
-        ];
-        for (table, i, partner, c) in cohesion {
-            let m = c.len();
-            let partner_name = if table == "pairs" { "j" } else { "wall" };
-            ds(&mut b, &format!("cohesion/{table}/i"), &[m], &i);
-            ds(&mut b, &format!("cohesion/{table}/{partner_name}"), &[m], &partner);
-            let volume = f(c.iter().map(|x| x.bridge_volume_m3));
-            ds(&mut b, &format!("cohesion/{table}/bridge_volume_m3"), &[m], &volume);
-            let in_well: Vec<u8> = c.iter().map(|x| u8::from(x.in_well)).collect();
-            ds(&mut b, &format!("cohesion/{table}/in_well"), &[m], &in_well);
-        }
         let tally = state.net_force.as_ref().expect("the sample records net forces");
         let walls = tally.wall_contact_n.len();
         ds(&mut b, "net_force/steps", &[1], &tally.steps.to_le_bytes());
@@ -1179,6 +1113,31 @@ mod tests {
                 &f(sums.iter().flat_map(|v| v.iter().copied())),
             );
         }
+        // The history records' fields, as the documentation lists them: pairs, then walls, slot by slot.
+        for (table, _, _, h) in &tables {
+            let m = h.len();
+            let flag = |get: fn(&ContactHistory) -> bool| -> Vec<u8> { h.iter().map(|x| u8::from(get(x))).collect() };
+            let vec = |get: fn(&ContactHistory) -> Vec3| v3(&h.iter().map(get).collect::<Vec<_>>());
+            let scalar = |get: fn(&ContactHistory) -> f64| f(h.iter().map(get));
+            let path = |name: &str| format!("contacts/{table}/{name}");
+            ds(&mut b, &path("yielded"), &[m], &flag(|x| x.normal.yielded));
+            ds(
+                &mut b,
+                &path("max_overlap_m"),
+                &[m],
+                &scalar(|x| x.normal.max_overlap_m),
+            );
+            let max_force = scalar(|x| x.normal.max_normal_force_n);
+            ds(&mut b, &path("max_normal_force_n"), &[m], &max_force);
+            ds(&mut b, &path("shear"), &[m, 3], &vec(|x| x.tangential.shear));
+            let reversal = vec(|x| x.tangential.reversal_force_n);
+            ds(&mut b, &path("reversal_force_n"), &[m, 3], &reversal);
+            let direction = vec(|x| x.tangential.increment_direction);
+            ds(&mut b, &path("increment_direction"), &[m, 3], &direction);
+            let volume = scalar(|x| x.cohesion.bridge_volume_m3);
+            ds(&mut b, &path("bridge_volume_m3"), &[m], &volume);
+            ds(&mut b, &path("in_well"), &[m], &flag(|x| x.cohesion.in_well));
+        }
 
         assert_eq!(stored, xxhash_rust::xxh3::xxh3_64(&b));
     }
@@ -1186,7 +1145,7 @@ mod tests {
     #[test]
     fn schema_documents_every_dataset() {
         let doc = include_str!("../../schemas/checkpoint.md");
-        for spec in layout::DATASETS {
+        for spec in layout::all_datasets() {
             assert!(
                 doc.contains(&format!("`/{}`", spec.path)),
                 "schemas/checkpoint.md lacks /{}",

@@ -14,16 +14,17 @@
 //! crossing) in that order, so results do not depend on the thread count.
 
 use super::Vec3;
-use super::contacts::WallId;
+use super::contacts::AlignedHistory;
 use super::models::capillary::{
     MikamiBridge, bridge_volume_on_contact_m3, lian_rupture_gap_m, viscous_normal_force_n,
     viscous_tangential_coefficient_n_s_per_m,
 };
 use super::models::capillary_table::CapillaryTable;
 use super::models::cohesion_law::{CapillaryForce, CohesionModel, square_well_crossing};
+use super::models::history::CohesionHistory;
 use super::models::liquid_transfer::rupture_share_of_i;
 use super::neighbor::NeighborList;
-use super::particles::{ParticleId, Particles, SpeciesId, SpeciesTable};
+use super::particles::{Particles, SpeciesId, SpeciesTable};
 use super::simulation::SimConfig;
 
 /// A cohesion model with everything derived from it once per run.
@@ -285,43 +286,11 @@ impl RuptureTable {
     }
 }
 
-/// What one pair or particle–wall slot carries between steps.
-#[derive(Debug, Clone, Copy, PartialEq, Default)]
-pub struct CohesionState {
-    /// Liquid bridge volume, m³ (0: no bridge).
-    pub bridge_volume_m3: f64,
-    /// Square well: the pair is inside the well.
-    pub in_well: bool,
-}
-
-impl CohesionState {
-    pub fn is_empty(&self) -> bool {
-        self.bridge_volume_m3 == 0.0 && !self.in_well
-    }
-}
-
-/// The non-empty cohesion states, keyed and sorted like the contact store (checkpoints hold this).
-#[derive(Debug, Clone, Default, PartialEq)]
-pub struct CohesionStore {
-    pub pairs: Vec<(ParticleId, ParticleId, CohesionState)>,
-    pub walls: Vec<(ParticleId, WallId, CohesionState)>,
-}
-
-impl CohesionStore {
-    /// Total liquid held in bridges, m³.
-    pub fn bridge_liquid_m3(&self) -> f64 {
-        self.pairs.iter().map(|(_, _, s)| s.bridge_volume_m3).sum::<f64>()
-            + self.walls.iter().map(|(_, _, s)| s.bridge_volume_m3).sum::<f64>()
-    }
-}
-
-/// Cohesion states aligned with the slots of a [`NeighborList`].
+/// Workspace of the cohesion pass aligned with the slots of a [`NeighborList`]: per pair slot, the Mikami constants
+/// and rupture gap of its bridge for the volume they were computed for (rebuilt from the state, never
+/// checkpointed). The per-pair state itself is the cohesion slot of the contact history (`models::history`).
 #[derive(Debug, Clone, Default)]
-pub struct AlignedCohesion {
-    pub pair: Vec<CohesionState>,
-    pub wall: Vec<CohesionState>,
-    /// Per pair slot: the Mikami constants and rupture gap of its bridge, for the volume they were computed for
-    /// (workspace: rebuilt from the state, never checkpointed).
+pub struct BridgeCache {
     bridges: Vec<BridgeConstants>,
 }
 
@@ -345,80 +314,6 @@ impl BridgeConstants {
     };
 }
 
-impl AlignedCohesion {
-    /// The non-empty states in key order.
-    pub fn to_store(&self, list: &NeighborList) -> CohesionStore {
-        let n = list.start.len().saturating_sub(1);
-        let mut store = CohesionStore::default();
-        if self.pair.len() != list.partner.len() || self.wall.len() != list.wall_partner.len() {
-            // Not sized for this list: no pass has run since it was built, and a rebuild carries every state
-            // over, so there is none.
-            debug_assert!(self.pair.iter().chain(&self.wall).all(CohesionState::is_empty));
-            return store;
-        }
-        for i in 0..n {
-            for k in list.pairs_of(i) {
-                if !self.pair[k].is_empty() {
-                    store
-                        .pairs
-                        .push((ParticleId(i as u32), ParticleId(list.partner[k]), self.pair[k]));
-                }
-            }
-            for k in list.walls_of(i) {
-                if !self.wall[k].is_empty() {
-                    store
-                        .walls
-                        .push((ParticleId(i as u32), WallId(list.wall_partner[k]), self.wall[k]));
-                }
-            }
-        }
-        store
-    }
-
-    /// States for `list` from `store`. A state whose pair is not a candidate of `list` (which the neighbour reach
-    /// rules out) is dropped: its bridge volume goes back to the particles, half each (to i alone for a wall), so
-    /// that liquid stays conserved, and it is counted in the second return value.
-    pub fn from_store(store: &CohesionStore, list: &NeighborList, liquid_m3: &mut [f64]) -> (AlignedCohesion, usize) {
-        if store.pairs.is_empty() && store.walls.is_empty() {
-            // Sized by the first pass that needs the columns (none in a run without cohesion).
-            return (AlignedCohesion::default(), 0);
-        }
-        let n = list.start.len().saturating_sub(1);
-        let mut out = AlignedCohesion {
-            pair: vec![CohesionState::default(); list.partner.len()],
-            wall: vec![CohesionState::default(); list.wall_partner.len()],
-            bridges: Vec::new(),
-        };
-        let mut orphans = 0;
-        for &(i, j, s) in &store.pairs {
-            let slots = if i.index() < n { list.pairs_of(i.index()) } else { 0..0 };
-            match list.partner[slots.clone()].binary_search(&j.0) {
-                Ok(offset) => out.pair[slots.start + offset] = s,
-                Err(_) => {
-                    orphans += 1;
-                    if let (Some(_), Some(_)) = (liquid_m3.get(i.index()), liquid_m3.get(j.index())) {
-                        liquid_m3[i.index()] += 0.5 * s.bridge_volume_m3;
-                        liquid_m3[j.index()] += s.bridge_volume_m3 - 0.5 * s.bridge_volume_m3;
-                    }
-                }
-            }
-        }
-        for &(i, w, s) in &store.walls {
-            let slots = if i.index() < n { list.walls_of(i.index()) } else { 0..0 };
-            match list.wall_partner[slots.clone()].binary_search(&w.0) {
-                Ok(offset) => out.wall[slots.start + offset] = s,
-                Err(_) => {
-                    orphans += 1;
-                    if let Some(l) = liquid_m3.get_mut(i.index()) {
-                        *l += s.bridge_volume_m3;
-                    }
-                }
-            }
-        }
-        (out, orphans)
-    }
-}
-
 /// The Young–Laplace force table of one species pair, from the disk cache when it holds it (built and cached
 /// otherwise; `capillary_cache.rs`).
 fn capillary_table(radius_1_m: f64, radius_2_m: f64, angle_1_rad: f64, angle_2_rad: f64) -> CapillaryTable {
@@ -433,10 +328,10 @@ fn capillary_table(radius_1_m: f64, radius_2_m: f64, angle_1_rad: f64, angle_2_r
 }
 
 /// Liquid on the particles and in the bridges, m³.
-pub fn total_liquid_m3(liquid_m3: &[f64], state: &AlignedCohesion) -> f64 {
+pub fn total_liquid_m3(liquid_m3: &[f64], history: &AlignedHistory) -> f64 {
     liquid_m3.iter().sum::<f64>()
-        + state.pair.iter().map(|s| s.bridge_volume_m3).sum::<f64>()
-        + state.wall.iter().map(|s| s.bridge_volume_m3).sum::<f64>()
+        + history.pair.cohesion.bridge_volume_m3.iter().sum::<f64>()
+        + history.wall.cohesion.bridge_volume_m3.iter().sum::<f64>()
 }
 
 /// What a pass did, for diagnostics.
@@ -448,7 +343,7 @@ pub struct CohesionPass {
 }
 
 /// Adds the cohesion forces at the current positions (velocities at the half step) to `p.force_n` and
-/// `p.torque_n_m`, updating `state` and the particles' liquid. `dt_s` turns the square well's crossing impulses
+/// `p.torque_n_m`, updating the cohesion slot of `history` and the particles' liquid. `dt_s` turns the square well's crossing impulses
 /// into forces acting for one step (the two half kicks of velocity Verlet deliver exactly F dt). With `per_wall_n`,
 /// each wall's cohesion force on all particles is added there too (index = wall, particles ascending).
 #[allow(clippy::too_many_arguments)]
@@ -457,23 +352,20 @@ pub fn apply_cohesion(
     config: &SimConfig,
     p: &mut Particles,
     list: &NeighborList,
-    state: &mut AlignedCohesion,
+    history: &mut AlignedHistory,
+    cache: &mut BridgeCache,
     wall_angle_rad: &[f64],
     dt_s: f64,
     mut per_wall_n: Option<&mut [Vec3]>,
 ) -> CohesionPass {
     let n = p.len();
     let mut pass = CohesionPass::default();
-    if state.pair.len() != list.partner.len() {
-        state.pair.resize(list.partner.len(), CohesionState::default());
+    if cache.bridges.len() != list.partner.len() {
+        cache.bridges.clear();
+        cache.bridges.resize(list.partner.len(), BridgeConstants::NONE);
     }
-    if state.wall.len() != list.wall_partner.len() {
-        state.wall.resize(list.wall_partner.len(), CohesionState::default());
-    }
-    if state.bridges.len() != state.pair.len() {
-        state.bridges.clear();
-        state.bridges.resize(state.pair.len(), BridgeConstants::NONE);
-    }
+    let pair_state = &mut history.pair.cohesion;
+    let wall_state = &mut history.wall.cohesion;
     for i in 0..n {
         let (xi, vi, wi, ri, mi, si) = (
             p.position_m[i],
@@ -494,7 +386,10 @@ pub fn apply_cohesion(
             let (rj, mj, sj) = (p.radius_m[j], p.mass_kg[j], p.species[j]);
             let reach = ri + rj;
             let dist2 = d.norm_squared();
-            let slot = &mut state.pair[k];
+            let mut slot = CohesionHistory {
+                bridge_volume_m3: pair_state.bridge_volume_m3[k],
+                in_well: pair_state.in_well[k],
+            };
             // Out of range and carrying nothing: the common case.
             let range = reach + cohesion.range_m;
             if dist2 >= range * range && slot.is_empty() {
@@ -523,7 +418,7 @@ pub fn apply_cohesion(
                             pass.bridges_formed += 1;
                         }
                     }
-                    let constants = &mut state.bridges[k];
+                    let constants = &mut cache.bridges[k];
                     if slot.bridge_volume_m3 > 0.0 && constants.volume_m3 != slot.bridge_volume_m3 {
                         let pair = cohesion.pair_index(si, sj);
                         *constants = BridgeConstants {
@@ -593,6 +488,8 @@ pub fn apply_cohesion(
                     }
                 }
             }
+            pair_state.bridge_volume_m3[k] = slot.bridge_volume_m3;
+            pair_state.in_well[k] = slot.in_well;
             if force_on_i != Vec3::zeros() {
                 p.force_n[i] += force_on_i;
                 p.force_n[j] -= force_on_i;
@@ -611,7 +508,10 @@ pub fn apply_cohesion(
                 }
                 let prox = config.walls[w].proximity(&xi, wall_angle_rad[w]);
                 let gap = prox.gap_m - ri;
-                let slot = &mut state.wall[k];
+                let mut slot = CohesionHistory {
+                    bridge_volume_m3: wall_state.bridge_volume_m3[k],
+                    in_well: wall_state.in_well[k],
+                };
                 if gap >= cohesion.wall_range_m && slot.is_empty() {
                     continue;
                 }
@@ -684,6 +584,8 @@ pub fn apply_cohesion(
                         }
                     }
                 };
+                wall_state.bridge_volume_m3[k] = slot.bridge_volume_m3;
+                wall_state.in_well[k] = slot.in_well;
                 p.force_n[i] += prox.normal * force;
                 if let Some(out) = per_wall_n.as_deref_mut() {
                     out[w] += tangential + prox.normal * force;

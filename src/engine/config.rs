@@ -4,6 +4,7 @@
 
 use super::cohesion::Cohesion;
 use super::geometry::{Domain, Gravity, Wall};
+use super::models::history::HistoryLayout;
 use super::models::{ContactLaw, PairTable};
 use super::neighbor::Reach;
 use super::particles::SpeciesTable;
@@ -38,6 +39,15 @@ pub struct SimConfig {
 }
 
 impl SimConfig {
+    /// The history columns the run's models use: the contact law's, and the cohesion slot's when there is a
+    /// cohesion model.
+    pub fn history_layout(&self) -> HistoryLayout {
+        HistoryLayout {
+            cohesion: self.cohesion.is_some(),
+            ..self.contact_law.history_layout()
+        }
+    }
+
     /// How far beyond contact the neighbour list must reach for the cohesion model.
     pub fn reach(&self) -> Reach {
         self.cohesion.as_ref().map_or(Reach::default(), |c| Reach {

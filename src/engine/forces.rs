@@ -19,6 +19,7 @@ use super::Vec3;
 use super::contacts::{AlignedHistory, ColumnsMut, split_at_ends};
 use super::geometry::Wall;
 use super::integrate::{InverseInertia, half_kick_one};
+use super::models::history::ContactLayout;
 use super::models::{ContactKinematics, ContactLaw, PairTable};
 use super::neighbor::{BUILD_CHUNK, NeighborList};
 use super::particles::{ParticleId, Particles, SpeciesId};
@@ -292,7 +293,7 @@ impl<'a> Context<'a> {
         let (ri, rj) = (bi.radius_m, self.radius_m[j]);
         let reach = ri + rj;
         if dist2 >= reach * reach {
-            hist.release(k);
+            hist.release_as::<ContactLayout<WB, TH>>(k);
             return None;
         }
         let dist = dist2.sqrt();
@@ -318,9 +319,9 @@ impl<'a> Context<'a> {
             relative_angular_velocity: wi - wj,
         };
         let mat = self.table.get(bi.species, self.species[j]);
-        let mut h = hist.load_as::<WB, TH>(k);
+        let mut h = hist.load_as::<ContactLayout<WB, TH>>(k);
         let out = self.law.evaluate(mat, &kin, self.dt_s, &mut h);
-        hist.save_as::<WB, TH>(k, &h);
+        hist.save_as::<ContactLayout<WB, TH>>(k, &h);
         let nxft = n.cross(&out.tangential_force);
         Some(PairResult {
             force: out.force,
@@ -353,7 +354,7 @@ impl<'a> Context<'a> {
             let prox = wall.proximity(&x, self.wall_angle[w as usize]);
             let overlap = ri - prox.gap_m;
             if overlap <= 0.0 {
-                hist.release(k);
+                hist.release_as::<ContactLayout<WB, TH>>(k);
                 continue;
             }
             worst.note(overlap, ri, i, u32::MAX - w as u32);
@@ -368,9 +369,9 @@ impl<'a> Context<'a> {
                 relative_angular_velocity: wi - prox.wall_angular_velocity,
             };
             let mat = self.table.get(self.species[i], wall.species);
-            let mut h = hist.load_as::<WB, TH>(k);
+            let mut h = hist.load_as::<ContactLayout<WB, TH>>(k);
             let out = self.law.evaluate(mat, &kin, self.dt_s, &mut h);
-            hist.save_as::<WB, TH>(k, &h);
+            hist.save_as::<ContactLayout<WB, TH>>(k, &h);
             *f += out.force;
             *t += -(n.cross(&out.tangential_force) * ri) + out.rolling_torque;
         }

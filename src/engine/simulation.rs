@@ -8,7 +8,7 @@
 use std::sync::Arc;
 use std::time::{Duration, Instant};
 
-use super::cohesion::{AlignedCohesion, CohesionPass, apply_cohesion, total_liquid_m3};
+use super::cohesion::{BridgeCache, CohesionPass, apply_cohesion, total_liquid_m3};
 pub use super::config::SimConfig;
 use super::contacts::AlignedHistory;
 use super::forces::{ForcePass, HalfKick, PairBuffers, RangePlan, add_wall_contact_forces, compute_contact_forces};
@@ -59,9 +59,10 @@ pub struct Simulation {
     candidates: NeighborList,
     /// Refilters of `list` from `candidates` in this process.
     refilters: u64,
+    /// Contact histories and cohesion states, aligned with `list`.
     history: AlignedHistory,
-    /// Cohesion states (bridges, wells), aligned with `list` like `history`.
-    cohesion: AlignedCohesion,
+    /// The cohesion pass's per-slot bridge constants (workspace).
+    bridges: BridgeCache,
     /// Events of the cohesion passes since the start of this process.
     pub cohesion_events: CohesionPass,
     /// Liquid sprayed since the start of this process, m³ (the state keeps it per particle).
@@ -116,7 +117,7 @@ impl Simulation {
             candidates: NeighborList::default(),
             refilters: 0,
             history: AlignedHistory::default(),
-            cohesion: AlignedCohesion::default(),
+            bridges: BridgeCache::default(),
             cohesion_events: CohesionPass::default(),
             sprayed_m3: 0.0,
             buffers: PairBuffers::default(),
@@ -154,7 +155,7 @@ impl Simulation {
             candidates: NeighborList::default(),
             refilters: 0,
             history: AlignedHistory::default(),
-            cohesion: AlignedCohesion::default(),
+            bridges: BridgeCache::default(),
             cohesion_events: CohesionPass::default(),
             sprayed_m3: 0.0,
             buffers: PairBuffers::default(),
@@ -171,17 +172,13 @@ impl Simulation {
         };
         let team = Arc::clone(&sim.team);
         sim.build_lists(true, &team);
-        let layout = sim.config.contact_law.history_layout();
-        let (history, orphans) = AlignedHistory::from_store(&state.contacts, &sim.list, layout);
+        let layout = sim.config.history_layout();
+        let (history, orphans) =
+            AlignedHistory::from_store(&state.contacts, &sim.list, layout, &mut sim.particles.liquid_m3);
         if orphans > 0 {
             return Err(NumericalError::OrphanContacts { count: orphans });
         }
         sim.history = history;
-        let (cohesion, orphans) = AlignedCohesion::from_store(&state.cohesion, &sim.list, &mut sim.particles.liquid_m3);
-        if orphans > 0 {
-            return Err(NumericalError::OrphanContacts { count: orphans });
-        }
-        sim.cohesion = cohesion;
         sim.rebalance();
         Ok(sim)
     }
@@ -195,7 +192,6 @@ impl Simulation {
             particles: self.particles.clone(),
             wall_angle_rad: self.wall_angle_rad.clone(),
             contacts: self.history.to_store(&self.list),
-            cohesion: self.cohesion.to_store(&self.list),
             rng: self.rng,
             gas: self.gas.as_ref().map(|g| g.snapshot()),
             net_force: self.net_force.clone(),
@@ -532,7 +528,8 @@ impl Simulation {
             &self.config,
             &mut self.particles,
             &self.list,
-            &mut self.cohesion,
+            &mut self.history,
+            &mut self.bridges,
             &self.wall_angle_rad,
             dt,
             self.net_force.as_mut().map(|t| t.wall_cohesion_n.as_mut_slice()),
@@ -553,7 +550,7 @@ impl Simulation {
 
     /// Liquid on the particles plus liquid in bridges, m³.
     pub fn total_liquid_m3(&self) -> f64 {
-        total_liquid_m3(&self.particles.liquid_m3, &self.cohesion)
+        total_liquid_m3(&self.particles.liquid_m3, &self.history)
     }
 
     fn rebalance(&mut self) {
@@ -575,18 +572,16 @@ impl Simulation {
         let team = Arc::clone(&self.team);
         let team = &*team;
         self.build_lists(self.needs_cell_search(), team);
-        let layout = self.config.contact_law.history_layout();
-        let (history, orphans) = self.history.remap(&old_list, &self.list, layout, team);
-        // A contact is always a candidate of a list built from the same positions.
-        debug_assert_eq!(orphans, 0, "contacts lost in a neighbour-list rebuild");
+        let layout = self.config.history_layout();
+        let (history, orphans) = self
+            .history
+            .remap(&old_list, &self.list, layout, &mut self.particles.liquid_m3, team);
+        // A contact is always a candidate of a list built from the same positions, and a bridge or well pair is
+        // within the cohesion reach, hence a candidate too.
+        debug_assert_eq!(orphans, 0, "contact histories lost in a neighbour-list rebuild");
         self.history = history;
-        if self.config.cohesion.is_some() {
-            let store = self.cohesion.to_store(&old_list);
-            let (cohesion, orphans) = AlignedCohesion::from_store(&store, &self.list, &mut self.particles.liquid_m3);
-            // A bridge or well pair is always within the cohesion reach, hence a candidate.
-            debug_assert_eq!(orphans, 0, "cohesion states lost in a neighbour-list rebuild");
-            self.cohesion = cohesion;
-        }
+        // The bridge constants are per slot of the old list.
+        self.bridges = BridgeCache::default();
         self.rebalance();
     }
 

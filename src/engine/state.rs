@@ -6,12 +6,12 @@ use rand_chacha::ChaCha8Rng;
 use rand_chacha::rand_core::SeedableRng;
 
 use super::Vec3;
-use super::cohesion::{CohesionState, CohesionStore};
 use super::contacts::ContactStore;
 use super::gas::coupled::GasSnapshot;
 use super::models::ContactHistory;
+use super::models::history::{FieldValue, HISTORY_FIELDS};
 use super::net_force::NetForceTally;
-use super::particles::{ParticleId, Particles};
+use super::particles::Particles;
 
 /// The complete state of a ChaCha8 generator: seed, stream and position.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -52,9 +52,8 @@ pub struct SimState {
     pub particles: Particles,
     /// Angle turned by each wall (0 for static walls), rad.
     pub wall_angle_rad: Vec<f64>,
+    /// Contact histories and the cohesion model's per-pair states (liquid bridges, square-well pairs).
     pub contacts: ContactStore,
-    /// Liquid bridges and square-well pairs (empty without a cohesion model).
-    pub cohesion: CohesionStore,
     pub rng: RngState,
     /// The gas of a coupled run.
     pub gas: Option<GasSnapshot>,
@@ -100,36 +99,21 @@ pub fn first_difference(a: &SimState, b: &SimState) -> Option<String> {
             .enumerate()
             .find_map(|(i, (p, q))| v(&format!("{name}[{i}]"), p, q))
     }
+    /// Every field of the record, walked through the declaration's table (`models::history`), so that a field
+    /// added there is compared here too.
     fn history(name: &str, x: &ContactHistory, y: &ContactHistory) -> Option<String> {
-        if x.active != y.active || x.yielded != y.yielded {
-            return Some(format!(
-                "{name}: flags (active {}, yielded {}) vs ({}, {})",
-                x.active, x.yielded, y.active, y.yielded
-            ));
+        if x.active != y.active {
+            return Some(format!("{name}.active: {} vs {}", x.active, y.active));
         }
-        v(&format!("{name}.tangential"), &x.tangential, &y.tangential)
-            .or_else(|| {
-                v(
-                    &format!("{name}.reversal_force_n"),
-                    &x.reversal_force_n,
-                    &y.reversal_force_n,
-                )
-            })
-            .or_else(|| {
-                v(
-                    &format!("{name}.increment_direction"),
-                    &x.increment_direction,
-                    &y.increment_direction,
-                )
-            })
-            .or_else(|| f(&format!("{name}.max_overlap_m"), x.max_overlap_m, y.max_overlap_m))
-            .or_else(|| {
-                f(
-                    &format!("{name}.max_normal_force_n"),
-                    x.max_normal_force_n,
-                    y.max_normal_force_n,
-                )
-            })
+        HISTORY_FIELDS.iter().find_map(|field| {
+            let label = format!("{name}.{}.{}", field.slot, field.name);
+            match ((field.get)(x), (field.get)(y)) {
+                (FieldValue::Flag(p), FieldValue::Flag(q)) => (p != q).then(|| format!("{label}: {p} vs {q}")),
+                (FieldValue::Scalar(p), FieldValue::Scalar(q)) => f(&label, p, q),
+                (FieldValue::Vector(p), FieldValue::Vector(q)) => v(&label, &p, &q),
+                (p, q) => Some(format!("{label}: {p:?} vs {q:?}")),
+            }
+        })
     }
     if a.step != b.step {
         return Some(format!("step: {} vs {}", a.step, b.step));
@@ -143,14 +127,14 @@ pub fn first_difference(a: &SimState, b: &SimState) -> Option<String> {
     }
     if a.contacts.pairs.len() != b.contacts.pairs.len() {
         return Some(format!(
-            "contacts.pairs: {} vs {} active contacts",
+            "contacts.pairs: {} vs {} records",
             a.contacts.pairs.len(),
             b.contacts.pairs.len()
         ));
     }
     if a.contacts.walls.len() != b.contacts.walls.len() {
         return Some(format!(
-            "contacts.walls: {} vs {} active contacts",
+            "contacts.walls: {} vs {} records",
             a.contacts.walls.len(),
             b.contacts.walls.len()
         ));
@@ -256,30 +240,4 @@ pub fn first_difference(a: &SimState, b: &SimState) -> Option<String> {
         })
         .or_else(|| scalars("particles.liquid_m3", &p.liquid_m3, &q.liquid_m3))
         .or_else(|| scalars("particles.sprayed_m3", &p.sprayed_m3, &q.sprayed_m3))
-        .or_else(|| cohesion_difference(&a.cohesion, &b.cohesion))
-}
-
-fn cohesion_difference(a: &CohesionStore, b: &CohesionStore) -> Option<String> {
-    fn states<K: PartialEq + std::fmt::Debug>(
-        name: &str,
-        x: &[(ParticleId, K, CohesionState)],
-        y: &[(ParticleId, K, CohesionState)],
-    ) -> Option<String> {
-        if x.len() != y.len() {
-            return Some(format!("{name}: {} vs {} entries", x.len(), y.len()));
-        }
-        x.iter().zip(y).enumerate().find_map(|(k, (p, q))| {
-            if p.0 != q.0 || p.1 != q.1 {
-                return Some(format!(
-                    "{name}[{k}]: key ({}, {:?}) vs ({}, {:?})",
-                    p.0.0, p.1, q.0.0, q.1
-                ));
-            }
-            if p.2.bridge_volume_m3.to_bits() != q.2.bridge_volume_m3.to_bits() || p.2.in_well != q.2.in_well {
-                return Some(format!("{name}[{k}] ({}, {:?}): {:?} vs {:?}", p.0.0, p.1, p.2, q.2));
-            }
-            None
-        })
-    }
-    states("cohesion.pairs", &a.pairs, &b.pairs).or_else(|| states("cohesion.walls", &a.walls, &b.walls))
 }

@@ -7,12 +7,12 @@
 use serde::{Deserialize, Serialize};
 
 use super::history::ContactHistory;
+use super::history::HistoryLayout;
 use super::normal::NormalModel;
 use super::pair_table::PairMaterial;
 use super::rolling::RollingModel;
 use super::tangential::TangentialModel;
 use crate::engine::Vec3;
-use crate::engine::contacts::HistoryLayout;
 
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize, schemars::JsonSchema)]
 #[serde(deny_unknown_fields)]
@@ -58,12 +58,13 @@ impl ContactLaw {
         [self.normal.name(), self.tangential.name(), self.rolling.name()]
     }
 
-    /// The history columns this law reads and writes.
+    /// The history columns this law reads and writes (the cohesion slot's are the cohesion model's).
     pub fn history_layout(&self) -> HistoryLayout {
         HistoryLayout {
             tangential: true,
             walton_braun: matches!(self.tangential, TangentialModel::WaltonBraun { .. }),
             thornton: matches!(self.normal, NormalModel::Thornton { .. }),
+            cohesion: false,
         }
     }
 
@@ -78,11 +79,16 @@ impl ContactLaw {
     ) -> ContactOutput {
         let n = k.normal;
         let vn = k.normal_velocity_m_per_s;
-        let normal = self
-            .normal
-            .force(mat, k.effective_radius_m, k.effective_mass_kg, k.overlap_m, vn, hist);
+        let normal = self.normal.force(
+            mat,
+            k.effective_radius_m,
+            k.effective_mass_kg,
+            k.overlap_m,
+            vn,
+            &mut hist.normal,
+        );
         let vt = k.contact_velocity - n * vn;
-        let ft = self.tangential.force(mat, &normal, &n, &vt, dt_s, hist);
+        let ft = self.tangential.force(mat, &normal, &n, &vt, dt_s, &mut hist.tangential);
         let rolling_torque = self.rolling.torque(
             mat.rolling_friction_coefficient,
             k.effective_radius_m,

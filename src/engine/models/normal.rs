@@ -7,7 +7,7 @@
 
 use serde::{Deserialize, Serialize};
 
-use super::history::ContactHistory;
+use super::history::NormalHistory;
 use super::pair_table::PairMaterial;
 
 /// √(5/6), from the Tsuji/LIGGGHTS viscoelastic damping coefficient.
@@ -73,7 +73,7 @@ impl NormalModel {
         effective_mass_kg: f64,
         overlap_m: f64,
         normal_velocity_m_per_s: f64,
-        hist: &mut ContactHistory,
+        hist: &mut NormalHistory,
     ) -> NormalOutput {
         match *self {
             NormalModel::LinearSpringDashpot {
@@ -162,7 +162,7 @@ pub fn thornton_force(
     yield_force_n: f64,
     plastic_slope: PlasticSlope,
     overlap_m: f64,
-    hist: &mut ContactHistory,
+    hist: &mut NormalHistory,
 ) -> f64 {
     let kn = 4.0 / 3.0 * effective_youngs_modulus_pa * effective_radius_m.sqrt();
     if overlap_m >= hist.max_overlap_m {
@@ -245,7 +245,7 @@ mod tests {
         let r: f64 = 1e-3;
         let kn = 4.0 / 3.0 * mat.effective_youngs_modulus_pa * r.sqrt();
         let ay = (mat.yield_force_n / kn).powf(2.0 / 3.0);
-        let mut h = ContactHistory::default();
+        let mut h = NormalHistory::default();
         let below = thornton_force(
             mat.effective_youngs_modulus_pa,
             r,
@@ -272,7 +272,7 @@ mod tests {
     fn thornton_unloading_passes_through_max_and_leaves_plastic_overlap() {
         let mat = steel_like();
         let r: f64 = 1e-3;
-        let mut h = ContactHistory::default();
+        let mut h = NormalHistory::default();
         let kn = 4.0 / 3.0 * mat.effective_youngs_modulus_pa * r.sqrt();
         let ay = (mat.yield_force_n / kn).powf(2.0 / 3.0);
         let amax = 3.0 * ay;

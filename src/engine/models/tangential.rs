@@ -7,7 +7,7 @@
 
 use serde::{Deserialize, Serialize};
 
-use super::history::{ContactHistory, rotate_into_tangent_plane};
+use super::history::{TangentialHistory, rotate_into_tangent_plane};
 use super::normal::NormalOutput;
 use super::pair_table::PairMaterial;
 use crate::engine::Vec3;
@@ -65,7 +65,7 @@ impl TangentialModel {
         n: &Vec3,
         tangential_velocity: &Vec3,
         dt_s: f64,
-        hist: &mut ContactHistory,
+        hist: &mut TangentialHistory,
     ) -> Vec3 {
         // CHOICE: friction acts only while the normal force is compressive (a damping-induced tensile normal force
         // at separation gives no friction). LIGGGHTS uses |F_n|; the difference is confined to the last steps of
@@ -91,7 +91,7 @@ impl TangentialModel {
                 // No accumulated displacement: the spring starts from zero every step, and keeps none. A separate
                 // arm, not an or-pattern with the one above and a flag: that changed the code generation of the
                 // whole force loop (+2.2 % instructions in `bench dem --steps 2000`, Hertz-Mindlin, callgrind).
-                hist.tangential = Vec3::zeros();
+                hist.shear = Vec3::zeros();
                 let force = spring_with_coulomb_limit(
                     stiffness_n_per_m,
                     tangential_velocity * damping_kg_per_s,
@@ -101,7 +101,7 @@ impl TangentialModel {
                     dt_s,
                     hist,
                 );
-                hist.tangential = Vec3::zeros();
+                hist.shear = Vec3::zeros();
                 force
             }
             TangentialModel::Mindlin => {
@@ -133,23 +133,23 @@ fn spring_with_coulomb_limit(
     n: &Vec3,
     tangential_velocity: &Vec3,
     dt_s: f64,
-    hist: &mut ContactHistory,
+    hist: &mut TangentialHistory,
 ) -> Vec3 {
-    let displacement = rotate_into_tangent_plane(hist.tangential, n) + tangential_velocity * dt_s;
+    let displacement = rotate_into_tangent_plane(hist.shear, n) + tangential_velocity * dt_s;
     let trial = -(displacement * stiffness) - viscous;
     let trial_mag2 = trial.norm_squared();
     if trial_mag2 > limit * limit {
         // Sliding: the force sits on the Coulomb limit and the spring is reset to what that force implies
         // (Cundall-Strack; LAMMPS granular).
         let force = trial * (limit / trial_mag2.sqrt());
-        hist.tangential = if stiffness > 0.0 {
+        hist.shear = if stiffness > 0.0 {
             -(force + viscous) / stiffness
         } else {
             Vec3::zeros()
         };
         force
     } else {
-        hist.tangential = displacement;
+        hist.shear = displacement;
         trial
     }
 }
@@ -168,9 +168,9 @@ fn walton_braun(
     n: &Vec3,
     tangential_velocity: &Vec3,
     dt_s: f64,
-    hist: &mut ContactHistory,
+    hist: &mut TangentialHistory,
 ) -> Vec3 {
-    let mut force = rotate_into_tangent_plane(hist.tangential, n);
+    let mut force = rotate_into_tangent_plane(hist.shear, n);
     let mut reversal = rotate_into_tangent_plane(hist.reversal_force_n, n);
     let slip = tangential_velocity * dt_s;
     let slip_mag = slip.norm();
@@ -195,7 +195,7 @@ fn walton_braun(
     if mag2 > limit * limit {
         force *= limit / mag2.sqrt();
     }
-    hist.tangential = force;
+    hist.shear = force;
     hist.reversal_force_n = reversal;
     force
 }
@@ -227,7 +227,7 @@ mod tests {
             viscoelastic_damping_kg_per_s: 0.0,
         };
         let model = TangentialModel::WaltonBraun { exponent: 1.0 / 3.0 };
-        let mut h = ContactHistory::default();
+        let mut h = TangentialHistory::default();
         let v = Vec3::new(-0.1, 0.0, 0.0); // pushes F_t towards +x
         let mut f = Vec3::zeros();
         for _ in 0..20000 {
@@ -256,7 +256,7 @@ mod tests {
             stiffness_n_per_m: 1000.0,
             damping_kg_per_s: 0.0,
         };
-        let mut h = ContactHistory::default();
+        let mut h = TangentialHistory::default();
         let v = Vec3::new(0.0, 1.0, 0.0);
         let mut f = Vec3::zeros();
         for _ in 0..1000 {
@@ -279,7 +279,7 @@ mod tests {
             stiffness_n_per_m: kt,
             damping_kg_per_s: eta,
         };
-        let mut h = ContactHistory::default();
+        let mut h = TangentialHistory::default();
         // Slow sliding: the same force every step (nothing accumulates), −(K_t Δt + η_t) v_t, μF_n = 0.5 not reached.
         let v = Vec3::new(0.0, 1.0, 2.0);
         for _ in 0..1000 {
@@ -289,7 +289,7 @@ mod tests {
                 (f - expected).norm() < 1e-15 * expected.norm().max(1.0),
                 "{f:?} vs {expected:?}"
             );
-            assert_eq!(h.tangential, Vec3::zeros());
+            assert_eq!(h.shear, Vec3::zeros());
         }
         // Fast sliding: on the Coulomb limit.
         let fast = Vec3::new(0.0, 100.0, 0.0);
