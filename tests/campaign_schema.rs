@@ -92,6 +92,11 @@ fn the_schema_rejects_what_the_parser_rejects() {
     let mut doc: serde_json::Value = serde_norway::from_str(&text).unwrap();
     doc["base"]["species"][0]["radius_m"] = serde_json::json!("big");
     assert!(!validator.is_valid(&doc), "a string for a number");
+    let mut doc: serde_json::Value = serde_norway::from_str(&text).unwrap();
+    doc["metrics"] = serde_json::json!(["lacey_index", "kinetic_energy_j"]);
+    assert!(validator.is_valid(&doc), "known metric names");
+    doc["metrics"] = serde_json::json!(["kinetic_energi_j"]);
+    assert!(!validator.is_valid(&doc), "an unknown metric name");
 }
 
 /// A sweep may set an optional section the base leaves out (`cohesion` here: none, or a whole model), and an
