@@ -49,7 +49,7 @@ pub enum Command {
         #[command(subcommand)]
         which: BenchCommand,
     },
-    /// List every model name with its parameters and units.
+    /// List every model name with its parameters and units, and every per-job metric with its unit.
     Models,
     /// Print the JSON Schema of the campaign file (also in schemas/campaign.schema.json).
     Schema,
@@ -304,7 +304,7 @@ pub fn run(cli: Cli) -> Result<i32> {
             Ok(0)
         }
         Command::Models => {
-            emit(crate::models_doc::MODELS)?;
+            emit(&crate::models_doc::text())?;
             Ok(0)
         }
         Command::CohesionMap {
@@ -365,8 +365,8 @@ pub fn run(cli: Cli) -> Result<i32> {
             dispatch_campaign(&loaded, &campaign, &dir, dispatch, force)
         }
         Command::Resume { dir, dispatch } => {
-            let loaded = inspect::load_stored_campaign(&dir)?;
-            let source = crate::orchestrate::dispatcher::spec_copy_path(&dir);
+            let loaded = crate::campaign_dir::load_stored_campaign(&dir)?;
+            let source = crate::campaign_dir::spec_copy_path(&dir);
             dispatch_campaign(&loaded, &source, &dir, dispatch, false)
         }
         Command::Status { dir } => {
@@ -417,7 +417,7 @@ pub fn run(cli: Cli) -> Result<i32> {
                         std::fs::create_dir_all(parent)
                             .map_err(|e| crate::error::Error::io("create directory", parent, e))?;
                     }
-                    crate::simulate::write_atomic(&path, text.as_bytes())?;
+                    crate::util::write_atomic(&path, text.as_bytes())?;
                     eprintln!("{}: {}", path.display(), text.lines().last().unwrap_or_default());
                 }
                 None => emit(&text)?,

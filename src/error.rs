@@ -61,4 +61,14 @@ impl Error {
     }
 }
 
+impl From<crate::util::AtomicWriteError> for Error {
+    fn from(e: crate::util::AtomicWriteError) -> Self {
+        Error::Io {
+            action: e.action,
+            path: e.path,
+            source: e.source,
+        }
+    }
+}
+
 pub type Result<T, E = Error> = std::result::Result<T, E>;

@@ -1,12 +1,12 @@
 //! Reading a campaign directory: `status`, `query` and `export`. All of it goes through a read-only connection, so
-//! it is safe while a dispatcher runs.
+//! it is safe while a dispatcher runs. What does not live here: the directory's layout and loading its stored
+//! campaign (`crate::campaign_dir`), and the validation report (`crate::report`).
 
-use std::fs::File;
 use std::path::{Path, PathBuf};
 
 use crate::campaign::{self, Campaign};
+use crate::campaign_dir::{database_path, load_stored_campaign, stored_campaign_id};
 use crate::error::Error;
-use crate::orchestrate::dispatcher::{database_path, spec_copy_path};
 use crate::store::{self, JobStatus, Store};
 
 /// Output formats of `query` and `export`.
@@ -21,47 +21,11 @@ fn store_err(e: store::StoreError) -> Error {
     Error::External(e.to_string())
 }
 
-/// The campaign stored in a campaign directory (its copy of the campaign file).
-pub fn load_stored_campaign(dir: &Path) -> Result<Campaign, Error> {
-    let path = spec_copy_path(dir);
-    if !path.exists() {
-        return Err(Error::External(format!(
-            "{} is not a campaign directory (no {})",
-            dir.display(),
-            path.display()
-        )));
-    }
-    Ok(campaign::load(&path)?)
-}
-
 fn open(dir: &Path) -> Result<(Store, i64, Campaign), Error> {
     let campaign = load_stored_campaign(dir)?;
     let store = Store::open_read_only(database_path(dir)).map_err(store_err)?;
     let id = stored_campaign_id(&store, &campaign, dir)?;
     Ok((store, id, campaign))
-}
-
-/// The database id of the campaign stored in `dir`.
-pub fn stored_campaign_id(store: &Store, campaign: &Campaign, dir: &Path) -> Result<i64, Error> {
-    Ok(store
-        .campaign_by_name(&campaign.spec.name)
-        .map_err(store_err)?
-        .ok_or_else(|| {
-            Error::External(format!(
-                "{}: no campaign `{}` in the database",
-                dir.display(),
-                campaign.spec.name
-            ))
-        })?
-        .id)
-}
-
-/// Whether a dispatcher holds the campaign's lock right now.
-fn dispatcher_running(dir: &Path) -> bool {
-    match File::open(dir.join("campaign.lock")) {
-        Ok(f) => matches!(f.try_lock_shared(), Err(std::fs::TryLockError::WouldBlock)),
-        Err(_) => false,
-    }
 }
 
 /// `granflow status`: jobs by state, running jobs' progress, failures with reasons, an ETA.
@@ -81,7 +45,7 @@ pub fn status(dir: &Path) -> Result<String, Error> {
         dir.display(),
         rows.len()
     );
-    let live = dispatcher_running(dir);
+    let live = crate::campaign_dir::is_locked(dir);
     out += &format!(
         "dispatcher: {}\n",
         if live {
@@ -112,7 +76,7 @@ pub fn status(dir: &Path) -> Result<String, Error> {
             "  failed {} ({}): {}: {}\n",
             r.job_id,
             label(&r.job_id),
-            r.exit_class.as_deref().unwrap_or("unknown"),
+            r.exit_class.map_or("unknown", |class| class.as_str()),
             r.error.as_deref().unwrap_or("")
         );
     }

@@ -1,6 +1,50 @@
-//! The text of `granflow models`: every model name a scenario can use, with its parameters and units. Kept next to
-//! the enums it describes by a test that parses every example below.
+//! The text of `granflow models`: every model name a scenario can use, with its parameters and units, then every
+//! per-job metric a campaign can ask for. The models are written out here and kept next to the enums they describe
+//! by tests that parse every example and find every variant; the metrics are generated from their table
+//! (`crate::campaign::metrics`).
 
+use crate::campaign::metrics::JobMetric;
+
+/// The width the metric descriptions are wrapped to, as the hand-written lines above them.
+const WIDTH: usize = 118;
+
+/// The whole text of `granflow models`.
+pub fn text() -> String {
+    let mut out = String::from(MODELS);
+    out.push_str("metrics (campaign files' `metrics:`; per job, stored with their units):\n");
+    for metric in JobMetric::ALL {
+        let needs: Vec<&str> = metric.needs().iter().map(|n| n.label()).collect();
+        out.push_str(&format!("  {} [{}]", metric.name(), metric.unit()));
+        if !needs.is_empty() {
+            out.push_str(&format!("  needs {}", needs.join(", ")));
+        }
+        out.push('\n');
+        out.push_str(&wrapped(metric.description(), "      ", WIDTH));
+    }
+    out
+}
+
+/// `text` in lines of at most `width` characters (a longer word stays whole), each starting with `indent`.
+fn wrapped(text: &str, indent: &str, width: usize) -> String {
+    let mut out = String::new();
+    let mut line = String::new();
+    for word in text.split_whitespace() {
+        if !line.is_empty() && indent.chars().count() + line.chars().count() + 1 + word.chars().count() > width {
+            out.push_str(&format!("{indent}{line}\n"));
+            line.clear();
+        }
+        if !line.is_empty() {
+            line.push(' ');
+        }
+        line.push_str(word);
+    }
+    if !line.is_empty() {
+        out.push_str(&format!("{indent}{line}\n"));
+    }
+    out
+}
+
+/// The models part of the text, written by hand.
 pub const MODELS: &str = r#"contact.normal (one of):
   linear_spring_dashpot: { stiffness_n_per_m, damping_kg_per_s }       seed 001 eq. 6.16, seed 002 eq. 21
   hertz: { restitution }                                                 Hertz + Tsuji viscoelastic damping (LIGGGHTS)
@@ -66,7 +110,48 @@ gas (optional: a gas coupled to the particles, fluidized beds):
 
 #[cfg(test)]
 mod tests {
-    use super::MODELS;
+    use super::{MODELS, text, wrapped};
+    use crate::campaign::metrics::JobMetric;
+
+    /// Every metric of the table is listed with its unit, what it needs and its whole description.
+    #[test]
+    fn every_metric_is_listed_with_its_unit_and_description() {
+        let text = text();
+        let metrics = &text[text.find("\nmetrics (").expect("a metrics section")..];
+        for metric in JobMetric::ALL {
+            let head = format!("\n  {} [{}]", metric.name(), metric.unit());
+            let at = metrics.find(&head).unwrap_or_else(|| panic!("{head} is not listed"));
+            // The entry runs to the next metric's line (two spaces in; its description lines have six).
+            let rest = &metrics[at + head.len()..];
+            let end = rest
+                .match_indices("\n  ")
+                .find(|(i, _)| !rest[i + 3..].starts_with(' '))
+                .map_or(rest.len(), |(i, _)| i);
+            let entry = &rest[..end];
+            let words: Vec<&str> = entry.split_whitespace().collect();
+            let description: Vec<&str> = metric.description().split_whitespace().collect();
+            assert!(
+                words.windows(description.len()).any(|w| w == description.as_slice()),
+                "{}: {entry}",
+                metric.name()
+            );
+            for need in metric.needs() {
+                assert!(entry.contains(need.label()), "{}: {entry}", metric.name());
+            }
+        }
+        for line in metrics.lines() {
+            assert!(line.chars().count() <= super::WIDTH, "too long: {line}");
+        }
+    }
+
+    #[test]
+    fn wrapping_keeps_every_word_and_the_width() {
+        let text = "a bb ccc dddd eeeee ffffff";
+        let out = wrapped(text, "  ", 10);
+        assert_eq!(out, "  a bb ccc\n  dddd\n  eeeee\n  ffffff\n");
+        assert!(out.lines().all(|l| l.chars().count() <= 10));
+        assert_eq!(wrapped("", "  ", 10), "");
+    }
     use crate::engine::models::cohesion_law::CohesionModel;
     use crate::engine::models::{ContactLaw, NormalModel, PlasticSlope, RollingModel, TangentialModel};
 

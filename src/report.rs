@@ -10,8 +10,8 @@ use std::path::Path;
 use serde_json::Value;
 
 use crate::campaign::validation::{CheckSpec, CheckValue};
+use crate::campaign_dir::{database_path, load_stored_campaign, spec_copy_path};
 use crate::error::Error;
-use crate::orchestrate::dispatcher::{database_path, spec_copy_path};
 use crate::store::Store;
 
 fn store_err(e: crate::store::StoreError) -> Error {
@@ -180,7 +180,7 @@ fn builds_paragraph(builds: &[(String, i64)]) -> String {
 
 /// The Markdown report of the validation campaign in `dir`, and whether every check passed.
 pub fn report(dir: &Path) -> Result<(String, bool), Error> {
-    let campaign = crate::inspect::load_stored_campaign(dir)?;
+    let campaign = load_stored_campaign(dir)?;
     let Some(validation) = campaign.spec.validation.clone() else {
         return Err(Error::External(format!(
             "campaign `{}` has no `validation:` section; `granflow report` is for validation campaigns",

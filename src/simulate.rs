@@ -14,6 +14,7 @@ use crate::checkpoint::{CheckpointMeta, CheckpointSeries};
 use crate::engine::{Simulation, Vec3};
 use crate::error::{Error, Result};
 use crate::scenario::{self, BuiltScenario};
+use crate::util::write_atomic;
 
 /// Options of one `simulate` invocation.
 #[derive(Debug, Clone)]
@@ -249,16 +250,7 @@ fn truncate_series(path: &Path, header: &str, step: u64, resuming: bool) -> Resu
             _ => {}
         }
     }
-    write_atomic(path, out.as_bytes())
-}
-
-/// Writes `bytes` to `path` through a temporary file and a rename.
-pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
-    let tmp = path.with_extension("tmp");
-    let mut f = std::fs::File::create(&tmp).map_err(|e| Error::io("create", &tmp, e))?;
-    f.write_all(bytes).map_err(|e| Error::io("write", &tmp, e))?;
-    f.sync_all().map_err(|e| Error::io("sync", &tmp, e))?;
-    std::fs::rename(&tmp, path).map_err(|e| Error::io("rename", path, e))
+    Ok(write_atomic(path, out.as_bytes())?)
 }
 
 /// Runs (or resumes) a scenario. Returns the summary of this invocation.

@@ -1,7 +1,17 @@
 //! `schemas/campaign.schema.json` is the schema the code generates (set GRANFLOW_UPDATE_SCHEMA=1 to rewrite it), and
-//! every campaign file in `campaigns/` validates against it and parses.
+//! every campaign file in `campaigns/` and `research/` (the probes) validates against it and parses.
 
 use std::path::{Path, PathBuf};
+
+/// Every committed campaign file: the product's (`campaigns/`) and the probes' (`research/`).
+fn committed_campaign_files(root: &Path) -> Vec<PathBuf> {
+    let mut files = Vec::new();
+    for dir in ["campaigns", "research"] {
+        campaign_files(&root.join(dir), &mut files);
+    }
+    files.sort();
+    files
+}
 
 fn campaign_files(dir: &Path, out: &mut Vec<PathBuf>) {
     for entry in std::fs::read_dir(dir).unwrap() {
@@ -35,9 +45,11 @@ fn every_campaign_file_validates_against_the_schema_and_parses() {
     let root = Path::new(env!("CARGO_MANIFEST_DIR"));
     let schema = granflow::campaign::json_schema();
     let validator = jsonschema::validator_for(&schema).expect("the schema is a valid JSON Schema");
-    let mut files = Vec::new();
-    campaign_files(&root.join("campaigns"), &mut files);
-    assert!(!files.is_empty());
+    let files = committed_campaign_files(root);
+    assert!(
+        files.iter().any(|f| f.starts_with(root.join("research"))),
+        "no probe campaign found"
+    );
     for file in files {
         let text = std::fs::read_to_string(&file).unwrap();
         let doc: serde_json::Value = serde_norway::from_str(&text).unwrap();
@@ -55,9 +67,7 @@ fn every_campaign_file_validates_against_the_schema_and_parses() {
 #[test]
 fn every_committed_job_and_scenario_validates() {
     let root = Path::new(env!("CARGO_MANIFEST_DIR"));
-    let mut files = Vec::new();
-    campaign_files(&root.join("campaigns"), &mut files);
-    for file in files {
+    for file in committed_campaign_files(root) {
         let campaign = granflow::campaign::load(&file).unwrap_or_else(|e| panic!("{}: {e}", file.display()));
         granflow::campaign::validate_jobs(&campaign, &campaign.jobs, &file)
             .unwrap_or_else(|e| panic!("{}: {e}", file.display()));
@@ -82,6 +92,11 @@ fn the_schema_rejects_what_the_parser_rejects() {
     let mut doc: serde_json::Value = serde_norway::from_str(&text).unwrap();
     doc["base"]["species"][0]["radius_m"] = serde_json::json!("big");
     assert!(!validator.is_valid(&doc), "a string for a number");
+    let mut doc: serde_json::Value = serde_norway::from_str(&text).unwrap();
+    doc["metrics"] = serde_json::json!(["lacey_index", "kinetic_energy_j"]);
+    assert!(validator.is_valid(&doc), "known metric names");
+    doc["metrics"] = serde_json::json!(["kinetic_energi_j"]);
+    assert!(!validator.is_valid(&doc), "an unknown metric name");
 }
 
 /// A sweep may set an optional section the base leaves out (`cohesion` here: none, or a whole model), and an

@@ -6,6 +6,7 @@ use std::collections::BTreeMap;
 use serde::{Deserialize, Serialize};
 use serde_json::Value;
 
+use super::metrics::JobMetric;
 use crate::analysis::fluidization::{SweepPoint, minimum_fluidization};
 
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize, schemars::JsonSchema)]
@@ -21,12 +22,13 @@ pub enum DerivedSpec {
 }
 
 impl DerivedSpec {
-    pub fn required_metrics(&self) -> &'static [&'static str] {
+    /// The per-job metrics it is computed from.
+    pub fn required_metrics(&self) -> &'static [JobMetric] {
         match self {
             DerivedSpec::MinimumFluidizationVelocity { .. } => &[
-                "pressure_drop_mean_pa",
-                "pressure_drop_std_pa",
-                "bed_weight_per_area_pa",
+                JobMetric::PressureDropMean,
+                JobMetric::PressureDropStd,
+                JobMetric::BedWeightPerArea,
             ],
         }
     }
@@ -51,7 +53,8 @@ pub struct DerivedValue {
 /// `metric.<name> [unit]` columns); only jobs with status `done` count.
 pub fn compute(specs: &[DerivedSpec], header: &[String], rows: &[Vec<Value>]) -> Vec<DerivedValue> {
     let column = |name: &str| header.iter().position(|h| h == name);
-    let metric_column = |name: &str| {
+    let metric_column = |metric: JobMetric| {
+        let name = metric.name();
         header
             .iter()
             .position(|h| h == &format!("metric.{name}") || h.starts_with(&format!("metric.{name} [")))
@@ -69,9 +72,9 @@ pub fn compute(specs: &[DerivedSpec], header: &[String], rows: &[Vec<Value>]) ->
             DerivedSpec::MinimumFluidizationVelocity { velocity_param } => {
                 let u = column(&format!("param.{velocity_param}"));
                 let (mean, std, weight) = (
-                    metric_column("pressure_drop_mean_pa"),
-                    metric_column("pressure_drop_std_pa"),
-                    metric_column("bed_weight_per_area_pa"),
+                    metric_column(JobMetric::PressureDropMean),
+                    metric_column(JobMetric::PressureDropStd),
+                    metric_column(JobMetric::BedWeightPerArea),
                 );
                 let mut groups: BTreeMap<String, Vec<SweepPoint>> = BTreeMap::new();
                 for row in rows {

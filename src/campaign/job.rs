@@ -7,6 +7,7 @@
 
 use serde::{Deserialize, Serialize};
 
+use super::metrics::JobMetric;
 use super::spec::AnalysisSpec;
 use crate::scenario::ScenarioSpec;
 
@@ -24,7 +25,8 @@ pub struct JobSpec {
     /// The parameters the sweep set, in sweep order: (path, value).
     pub params: Vec<(String, serde_json::Value)>,
     pub scenario: ScenarioSpec,
-    pub metrics: Vec<String>,
+    /// Written by name (`"lacey_index"`), so the job's id is that of the names.
+    pub metrics: Vec<JobMetric>,
     pub analysis: AnalysisSpec,
 }
 

@@ -1,17 +1,171 @@
-//! The per-job metrics a campaign can ask for: names, units, what they need.
+//! The per-job metrics a campaign can ask for (`metrics:` in a campaign file) as one closed set, [`JobMetric`],
+//! declared by the table below: one row per metric with its name (as campaign files write it and the database
+//! stores it), its SI unit, what it needs from the campaign and its scenario ([`Need`]), and what it is. `granflow
+//! models` and the campaign file's JSON Schema list the metrics from this table, and the checks here refuse an
+//! unknown name (with a did-you-mean) or a metric whose needs a job does not meet.
+//!
+//! What does not live here: computing the metrics (the worker's reducers, `crate::worker`'s `reduce.rs`, one
+//! exhaustive `match` over [`JobMetric`], so a new row does not build until its reducer exists) and the
+//! campaign-level metrics of several jobs ([`super::derived`]).
+
+use std::borrow::Cow;
+
+use serde::{Deserialize, Deserializer, Serialize, Serializer};
 
 use super::JobSpec;
 use super::spec::CampaignSpec;
 use crate::engine::models::cohesion_law::{CohesionModel, LiquidBridge};
 
-/// A metric a worker can reduce from its job.
-#[derive(Debug, Clone, Copy)]
-pub struct MetricInfo {
-    pub name: &'static str,
-    pub unit: &'static str,
-    pub description: &'static str,
-    /// What it needs from the campaign and its scenario.
-    pub needs: &'static [Need],
+/// Declares [`JobMetric`] from its table: `Variant => "name", "unit", [needs], "description";`.
+macro_rules! job_metrics {
+    ($($variant:ident => $name:literal, $unit:literal, [$($need:ident),*], $description:literal;)*) => {
+        /// A per-job metric: one number with a unit that a worker reduces from its finished job.
+        #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
+        pub enum JobMetric {
+            $(#[doc = $description] $variant,)*
+        }
+
+        impl JobMetric {
+            /// Every metric, in the table's order (the order `granflow models` and error messages list them in).
+            pub const ALL: &'static [JobMetric] = &[$(JobMetric::$variant,)*];
+
+            /// The name campaign files write, `result.json` and the database store.
+            pub fn name(self) -> &'static str {
+                match self {
+                    $(JobMetric::$variant => $name,)*
+                }
+            }
+
+            /// The SI unit of the value (`1` for a number without dimension).
+            pub fn unit(self) -> &'static str {
+                match self {
+                    $(JobMetric::$variant => $unit,)*
+                }
+            }
+
+            /// What the metric is, with the source of its definition.
+            pub fn description(self) -> &'static str {
+                match self {
+                    $(JobMetric::$variant => $description,)*
+                }
+            }
+
+            /// What it needs from the campaign and its scenario.
+            pub fn needs(self) -> &'static [Need] {
+                match self {
+                    $(JobMetric::$variant => &[$(Need::$need),*],)*
+                }
+            }
+        }
+    };
+}
+
+job_metrics! {
+    KineticEnergy => "kinetic_energy_j", "J", [],
+        "total (translational + rotational) kinetic energy at the end";
+    TranslationalKineticEnergy => "translational_kinetic_energy_j", "J", [],
+        "translational kinetic energy at the end";
+    BedTop => "bed_top_m", "m", [],
+        "highest particle centre along -gravity at the end (bed or column height)";
+    MeanHeight => "mean_height_m", "m", [],
+        "mean particle centre height along -gravity at the end";
+    CoordinationNumber => "coordination_number", "1", [],
+        "mean particle-particle contacts per particle at the end";
+    GranularTemperature => "granular_temperature_m2_per_s2", "m2/s2", [],
+        "granular temperature at the end (seed 000 eq. 3.1)";
+    IntensityOfSegregation => "intensity_of_segregation", "1", [MixingSpecies],
+        "IS at the end: std. dev. of the local volume fraction of the mixing species (seed 000 eqs 2.77-2.78)";
+    LaceyIndex => "lacey_index", "1", [MixingSpecies],
+        "Lacey mixing index at the end (seed 000 eq. 2.80)";
+    MixingRateConstant => "mixing_rate_constant_per_s", "1/s", [MixingSpecies],
+        "k of an exponential fit to IS(t) (seed 000 §4.1.3)";
+    MixingRateToRandom => "mixing_rate_to_random_per_s", "1/s", [MixingSpecies],
+        "k of IS(t) = IS_R + b exp(-k t) with IS_R = sqrt(P(1-P)/n) the random mixture's IS (n particles per local sample): the approach to a random mixture";
+    TimeTo90PctMaxLacey => "time_to_90pct_max_lacey_s", "s", [MixingSpecies],
+        "first time the Lacey index reaches 90 % of its maximum (seed 000 Table 1)";
+    MeanHeightTimeAverage => "mean_height_time_avg_m", "m", [],
+        "mean particle centre height along -gravity, averaged over the series from analysis.average_from_s (seed 002's mean particle height, 5-10 s)";
+    CoordinationNumberTimeAverage => "coordination_number_time_avg", "1", [],
+        "mean particle-particle contacts per particle, averaged over the series from analysis.average_from_s (seed 002 Fig. 5's bulk coordination number)";
+    BedWeightPerArea => "bed_weight_per_area_pa", "Pa", [Gas],
+        "weight of the particles over the inlet area, W/A (seed 000 eq. 2.74): what the pressure drop of a fluidized bed carries";
+    PressureDropMean => "pressure_drop_mean_pa", "Pa", [Gas],
+        "time-averaged pressure drop from the inlet face to the top layer of gas cells, from analysis.average_from_s";
+    PressureDropStd => "pressure_drop_std_pa", "Pa", [Gas],
+        "standard deviation of that pressure drop over the same window (its jump marks u_mf, seed 000 §4.1.2)";
+    GranularBondNumber => "granular_bond_number", "1", [LiquidBridges],
+        "Bo_g = F_c,max/W of the first species, F_c,max = 2πRγ cos θ (seed 000 §4.1.1)";
+    GranularBondNumber22 => "granular_bond_number_22", "1", [LiquidBridges, TwoSpecies],
+        "Bo_g of the second species";
+    GranularBondNumber12 => "granular_bond_number_12", "1", [LiquidBridges, TwoSpecies],
+        "Bo_g12: the 1-2 pair's F_c,max over the lighter particle's weight (seed 000 §4.2.1)";
+    GranularCapillaryNumber => "granular_capillary_number", "1", [Gas, LiquidBridges],
+        "Ca_g = F_c,max/F_d of the first species, Di Felice drag at slip U/ε (seed 000 eq. 4.3; analysis.capillary_number_porosity)";
+    GranularCapillaryNumber22 => "granular_capillary_number_22", "1", [Gas, LiquidBridges, TwoSpecies],
+        "Ca_g of the second species";
+    GranularCapillaryNumber12 => "granular_capillary_number_12", "1", [Gas, LiquidBridges, TwoSpecies],
+        "Ca_g12: the pair's F_c,max over the drag of the species with the larger F_d/W (seed 000 eqs. 4.4-4.5)";
+    WetPhaseMixed => "wet_phase_mixed", "1", [Gas, LiquidBridges, TwoSpecies],
+        "seed 000's phase rule on Ca_g11, Ca_g22, Ca_g12: 1 = more mixed than dry (M), 0 = more segregated (S)";
+    DefluidizationVelocity => "defluidization_velocity_m_per_s", "m/s", [Gas, InflowLevels],
+        "U_mf,df of a gas.inflow_levels cycle: the line through the falling branch's packed-bed level means meets W/A (seed 001 §6.4.2.1; with analysis.cycle_pressure: first_node, the first node's pressure drop against W'/A)";
+    FluidizationVelocityTheoretical => "fluidization_velocity_theoretical_m_per_s", "m/s", [Gas, InflowLevels],
+        "U_mf,th: the same on the rising branch";
+    IncipientFluidizationVelocity => "incipient_fluidization_velocity_m_per_s", "m/s", [Gas, InflowLevels],
+        "U_mf,in: the velocity of the overshoot peak, the rising branch's largest level-mean pressure drop before the first level whose mean falls (the bed gives way; seed 001: left of the bubbling region), when it exceeds W/A";
+    PressureOvershootRatio => "pressure_overshoot_ratio", "1", [Gas, InflowLevels],
+        "the overshoot peak (see incipient_fluidization_velocity_m_per_s) over W/A (above 1: an overshoot)";
+    OvershootFluidForcePerWeight => "overshoot_fluid_force_per_weight", "1", [Gas, InflowLevels, NetForces],
+        "the gas's force on all particles (its component against gravity) over their weight, averaged over the second half of the overshoot peak's level (see incipient_fluidization_velocity_m_per_s; the climb's top when there is no overshoot); seed 001 Figs 8.8-8.16";
+    OvershootDistributorContactPerWeight => "overshoot_distributor_contact_per_weight", "1", [Gas, InflowLevels, NetForces],
+        "the same for the contact force of the distributor (the plane walls facing against gravity)";
+    OvershootDistributorCohesionPerWeight => "overshoot_distributor_cohesion_per_weight", "1", [Gas, InflowLevels, NetForces],
+        "the same for the distributor's cohesion (negative: it holds the bed down)";
+    OvershootSidewallFrictionPerWeight => "overshoot_sidewall_friction_per_weight", "1", [Gas, InflowLevels, NetForces],
+        "the same for the sidewalls (plane walls parallel to gravity): their friction, with any tangential force of their cohesion (negative: they hold the bed down)";
+    OvershootSidewallNormalLoadPerWeight => "overshoot_sidewall_normal_load_per_weight", "1", [Gas, InflowLevels, NetForces],
+        "the same for the sidewalls' normal load: the size of their contact forces across gravity, summed over the sidewalls (in a pseudo-2-D bed exactly their normal load; in 3-D it also holds their horizontal friction); with μ, the friction they could give (the thesis: cohesion with the sidewalls only raises this load)";
+    SteppedFluidizationVelocity => "stepped_fluidization_velocity_m_per_s", "m/s", [Gas, InflowLevels],
+        "u_mf of a gas.inflow_levels run stepping the gas up: the slowest level of the rising branch from which the bed keeps moving (σ(ΔP) over the second half of each hold ≥ 1 % of W/A) at every faster level; NaN when the levels do not bracket the onset";
+    CoatingVariability => "coating_variability", "1", [Spray],
+        "CV_m = σ/μ of the liquid each particle received from the spray (seed 000 eq. 6.45)";
+    ProbePressureDropMean => "probe_pressure_drop_mean_pa", "Pa", [Gas, PressureProbe],
+        "time-averaged pressure drop from the inlet to gas.pressure_probe_height_m";
+}
+
+impl JobMetric {
+    /// The metric named `name`, as written by [`JobMetric::name`].
+    pub fn from_name(name: &str) -> Option<JobMetric> {
+        JobMetric::ALL.iter().copied().find(|m| m.name() == name)
+    }
+}
+
+impl Serialize for JobMetric {
+    fn serialize<S: Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
+        serializer.serialize_str(self.name())
+    }
+}
+
+impl<'de> Deserialize<'de> for JobMetric {
+    fn deserialize<D: Deserializer<'de>>(deserializer: D) -> Result<Self, D::Error> {
+        let name = Cow::<str>::deserialize(deserializer)?;
+        JobMetric::from_name(&name).ok_or_else(|| serde::de::Error::custom(format!("unknown metric `{name}`")))
+    }
+}
+
+impl schemars::JsonSchema for JobMetric {
+    fn schema_name() -> Cow<'static, str> {
+        "JobMetric".into()
+    }
+
+    fn json_schema(_: &mut schemars::SchemaGenerator) -> schemars::Schema {
+        let names: Vec<&str> = JobMetric::ALL.iter().map(|m| m.name()).collect();
+        schemars::json_schema!({
+            "description": "A per-job metric by name (`granflow models` lists them with their units).",
+            "type": "string",
+            "enum": names,
+        })
+    }
 }
 
 /// What a metric needs.
@@ -36,6 +190,20 @@ pub enum Need {
 }
 
 impl Need {
+    /// What the need asks for, as `granflow models` lists it.
+    pub fn label(self) -> &'static str {
+        match self {
+            Need::MixingSpecies => "analysis.mixing_species",
+            Need::Gas => "a gas",
+            Need::PressureProbe => "gas.pressure_probe_height_m",
+            Need::LiquidBridges => "liquid bridges",
+            Need::TwoSpecies => "two species",
+            Need::InflowLevels => "gas.inflow_levels",
+            Need::Spray => "a spray",
+            Need::NetForces => "output.net_forces",
+        }
+    }
+
     /// Why `job` does not meet this need (`None`: it does). `MixingSpecies` is checked on the campaign
     /// ([`check`]), where the key lives.
     fn unmet(self, name: &str, job: &JobSpec) -> Option<String> {
@@ -82,232 +250,17 @@ impl Need {
     }
 }
 
-pub const METRICS: &[MetricInfo] = &[
-    MetricInfo {
-        name: "kinetic_energy_j",
-        unit: "J",
-        description: "total (translational + rotational) kinetic energy at the end",
-        needs: &[],
-    },
-    MetricInfo {
-        name: "translational_kinetic_energy_j",
-        unit: "J",
-        description: "translational kinetic energy at the end",
-        needs: &[],
-    },
-    MetricInfo {
-        name: "bed_top_m",
-        unit: "m",
-        description: "highest particle centre along -gravity at the end (bed or column height)",
-        needs: &[],
-    },
-    MetricInfo {
-        name: "mean_height_m",
-        unit: "m",
-        description: "mean particle centre height along -gravity at the end",
-        needs: &[],
-    },
-    MetricInfo {
-        name: "coordination_number",
-        unit: "1",
-        description: "mean particle-particle contacts per particle at the end",
-        needs: &[],
-    },
-    MetricInfo {
-        name: "granular_temperature_m2_per_s2",
-        unit: "m2/s2",
-        description: "granular temperature at the end (seed 000 eq. 3.1)",
-        needs: &[],
-    },
-    MetricInfo {
-        name: "intensity_of_segregation",
-        unit: "1",
-        description: "IS at the end: std. dev. of the local volume fraction of the mixing species (seed 000 eqs 2.77-2.78)",
-        needs: &[Need::MixingSpecies],
-    },
-    MetricInfo {
-        name: "lacey_index",
-        unit: "1",
-        description: "Lacey mixing index at the end (seed 000 eq. 2.80)",
-        needs: &[Need::MixingSpecies],
-    },
-    MetricInfo {
-        name: "mixing_rate_constant_per_s",
-        unit: "1/s",
-        description: "k of an exponential fit to IS(t) (seed 000 §4.1.3)",
-        needs: &[Need::MixingSpecies],
-    },
-    MetricInfo {
-        name: "mixing_rate_to_random_per_s",
-        unit: "1/s",
-        description: "k of IS(t) = IS_R + b exp(-k t) with IS_R = sqrt(P(1-P)/n) the random mixture's IS (n particles per local sample): the approach to a random mixture",
-        needs: &[Need::MixingSpecies],
-    },
-    MetricInfo {
-        name: "time_to_90pct_max_lacey_s",
-        unit: "s",
-        description: "first time the Lacey index reaches 90 % of its maximum (seed 000 Table 1)",
-        needs: &[Need::MixingSpecies],
-    },
-    MetricInfo {
-        name: "mean_height_time_avg_m",
-        unit: "m",
-        description: "mean particle centre height along -gravity, averaged over the series from analysis.average_from_s (seed 002's mean particle height, 5-10 s)",
-        needs: &[],
-    },
-    MetricInfo {
-        name: "coordination_number_time_avg",
-        unit: "1",
-        description: "mean particle-particle contacts per particle, averaged over the series from analysis.average_from_s (seed 002 Fig. 5's bulk coordination number)",
-        needs: &[],
-    },
-    MetricInfo {
-        name: "bed_weight_per_area_pa",
-        unit: "Pa",
-        description: "weight of the particles over the inlet area, W/A (seed 000 eq. 2.74): what the pressure drop of a fluidized bed carries",
-        needs: &[Need::Gas],
-    },
-    MetricInfo {
-        name: "pressure_drop_mean_pa",
-        unit: "Pa",
-        description: "time-averaged pressure drop from the inlet face to the top layer of gas cells, from analysis.average_from_s",
-        needs: &[Need::Gas],
-    },
-    MetricInfo {
-        name: "pressure_drop_std_pa",
-        unit: "Pa",
-        description: "standard deviation of that pressure drop over the same window (its jump marks u_mf, seed 000 §4.1.2)",
-        needs: &[Need::Gas],
-    },
-    MetricInfo {
-        name: "granular_bond_number",
-        unit: "1",
-        description: "Bo_g = F_c,max/W of the first species, F_c,max = 2πRγ cos θ (seed 000 §4.1.1)",
-        needs: &[Need::LiquidBridges],
-    },
-    MetricInfo {
-        name: "granular_bond_number_22",
-        unit: "1",
-        description: "Bo_g of the second species",
-        needs: &[Need::LiquidBridges, Need::TwoSpecies],
-    },
-    MetricInfo {
-        name: "granular_bond_number_12",
-        unit: "1",
-        description: "Bo_g12: the 1-2 pair's F_c,max over the lighter particle's weight (seed 000 §4.2.1)",
-        needs: &[Need::LiquidBridges, Need::TwoSpecies],
-    },
-    MetricInfo {
-        name: "granular_capillary_number",
-        unit: "1",
-        description: "Ca_g = F_c,max/F_d of the first species, Di Felice drag at slip U/ε (seed 000 eq. 4.3; analysis.capillary_number_porosity)",
-        needs: &[Need::Gas, Need::LiquidBridges],
-    },
-    MetricInfo {
-        name: "granular_capillary_number_22",
-        unit: "1",
-        description: "Ca_g of the second species",
-        needs: &[Need::Gas, Need::LiquidBridges, Need::TwoSpecies],
-    },
-    MetricInfo {
-        name: "granular_capillary_number_12",
-        unit: "1",
-        description: "Ca_g12: the pair's F_c,max over the drag of the species with the larger F_d/W (seed 000 eqs. 4.4-4.5)",
-        needs: &[Need::Gas, Need::LiquidBridges, Need::TwoSpecies],
-    },
-    MetricInfo {
-        name: "wet_phase_mixed",
-        unit: "1",
-        description: "seed 000's phase rule on Ca_g11, Ca_g22, Ca_g12: 1 = more mixed than dry (M), 0 = more segregated (S)",
-        needs: &[Need::Gas, Need::LiquidBridges, Need::TwoSpecies],
-    },
-    MetricInfo {
-        name: "defluidization_velocity_m_per_s",
-        unit: "m/s",
-        description: "U_mf,df of a gas.inflow_levels cycle: the line through the falling branch's packed-bed level means meets W/A (seed 001 §6.4.2.1; with analysis.cycle_pressure: first_node, the first node's pressure drop against W'/A)",
-        needs: &[Need::Gas, Need::InflowLevels],
-    },
-    MetricInfo {
-        name: "fluidization_velocity_theoretical_m_per_s",
-        unit: "m/s",
-        description: "U_mf,th: the same on the rising branch",
-        needs: &[Need::Gas, Need::InflowLevels],
-    },
-    MetricInfo {
-        name: "incipient_fluidization_velocity_m_per_s",
-        unit: "m/s",
-        description: "U_mf,in: the velocity of the overshoot peak, the rising branch's largest level-mean pressure drop before the first level whose mean falls (the bed gives way; seed 001: left of the bubbling region), when it exceeds W/A",
-        needs: &[Need::Gas, Need::InflowLevels],
-    },
-    MetricInfo {
-        name: "pressure_overshoot_ratio",
-        unit: "1",
-        description: "the overshoot peak (see incipient_fluidization_velocity_m_per_s) over W/A (above 1: an overshoot)",
-        needs: &[Need::Gas, Need::InflowLevels],
-    },
-    MetricInfo {
-        name: "overshoot_fluid_force_per_weight",
-        unit: "1",
-        description: "the gas's force on all particles (its component against gravity) over their weight, averaged over the second half of the overshoot peak's level (see incipient_fluidization_velocity_m_per_s; the climb's top when there is no overshoot); seed 001 Figs 8.8-8.16",
-        needs: &[Need::Gas, Need::InflowLevels, Need::NetForces],
-    },
-    MetricInfo {
-        name: "overshoot_distributor_contact_per_weight",
-        unit: "1",
-        description: "the same for the contact force of the distributor (the plane walls facing against gravity)",
-        needs: &[Need::Gas, Need::InflowLevels, Need::NetForces],
-    },
-    MetricInfo {
-        name: "overshoot_distributor_cohesion_per_weight",
-        unit: "1",
-        description: "the same for the distributor's cohesion (negative: it holds the bed down)",
-        needs: &[Need::Gas, Need::InflowLevels, Need::NetForces],
-    },
-    MetricInfo {
-        name: "overshoot_sidewall_friction_per_weight",
-        unit: "1",
-        description: "the same for the sidewalls (plane walls parallel to gravity): their friction, with any tangential force of their cohesion (negative: they hold the bed down)",
-        needs: &[Need::Gas, Need::InflowLevels, Need::NetForces],
-    },
-    MetricInfo {
-        name: "overshoot_sidewall_normal_load_per_weight",
-        unit: "1",
-        description: "the same for the sidewalls' normal load: the size of their contact forces across gravity, summed over the sidewalls (in a pseudo-2-D bed exactly their normal load; in 3-D it also holds their horizontal friction); with μ, the friction they could give (the thesis: cohesion with the sidewalls only raises this load)",
-        needs: &[Need::Gas, Need::InflowLevels, Need::NetForces],
-    },
-    MetricInfo {
-        name: "stepped_fluidization_velocity_m_per_s",
-        unit: "m/s",
-        description: "u_mf of a gas.inflow_levels run stepping the gas up: the slowest level of the rising branch from which the bed keeps moving (σ(ΔP) over the second half of each hold ≥ 1 % of W/A) at every faster level; NaN when the levels do not bracket the onset",
-        needs: &[Need::Gas, Need::InflowLevels],
-    },
-    MetricInfo {
-        name: "coating_variability",
-        unit: "1",
-        description: "CV_m = σ/μ of the liquid each particle received from the spray (seed 000 eq. 6.45)",
-        needs: &[Need::Spray],
-    },
-    MetricInfo {
-        name: "probe_pressure_drop_mean_pa",
-        unit: "Pa",
-        description: "time-averaged pressure drop from the inlet to gas.pressure_probe_height_m",
-        needs: &[Need::Gas, Need::PressureProbe],
-    },
-];
-
-pub fn info(name: &str) -> Option<&'static MetricInfo> {
-    METRICS.iter().find(|m| m.name == name)
-}
-
-/// Checks the metric names and the analysis settings they need; errors are (key path, message).
-pub fn check(spec: &CampaignSpec) -> Result<(), (String, String)> {
+/// Checks the metric names and the analysis settings they need, and returns the metrics in the order listed;
+/// errors are (key path, message).
+pub fn check(spec: &CampaignSpec) -> Result<Vec<JobMetric>, (String, String)> {
     if spec.metrics.is_empty() {
         return Err(("metrics".into(), "expected at least one metric".into()));
     }
-    let names: Vec<&str> = METRICS.iter().map(|m| m.name).collect();
+    let names: Vec<&str> = JobMetric::ALL.iter().map(|m| m.name()).collect();
+    let mut metrics = Vec::with_capacity(spec.metrics.len());
     for (k, name) in spec.metrics.iter().enumerate() {
-        let Some(m) = info(name) else {
-            let hint = super::sweep::did_you_mean(name, &names)
+        let Some(m) = JobMetric::from_name(name) else {
+            let hint = crate::util::did_you_mean(name, &names)
                 .map(|s| format!("did you mean `{s}`? "))
                 .unwrap_or_default();
             return Err((
@@ -318,12 +271,13 @@ pub fn check(spec: &CampaignSpec) -> Result<(), (String, String)> {
         if spec.metrics[..k].contains(name) {
             return Err((format!("metrics[{k}]"), format!("metric `{name}` is listed twice")));
         }
-        if m.needs.contains(&Need::MixingSpecies) && spec.analysis.mixing_species.is_none() {
+        if m.needs().contains(&Need::MixingSpecies) && spec.analysis.mixing_species.is_none() {
             return Err((
                 format!("metrics[{k}]"),
                 format!("`{name}` needs `analysis.mixing_species` (which species is A in the binary mixture)"),
             ));
         }
+        metrics.push(m);
     }
     if let Some(t) = spec.analysis.average_from_s
         && !(t.is_finite() && t >= 0.0 && t < spec.base.time.end_time_s)
@@ -361,17 +315,13 @@ pub fn check(spec: &CampaignSpec) -> Result<(), (String, String)> {
             ),
         ));
     }
-    Ok(())
+    Ok(metrics)
 }
 
 /// Checks what depends on the resolved scenario (the mixing species must exist in it).
 pub fn check_job(job: &JobSpec) -> Result<(), (String, String)> {
-    for (k, name) in job.metrics.iter().enumerate() {
-        if let Some(message) = info(name)
-            .into_iter()
-            .flat_map(|m| m.needs)
-            .find_map(|need| need.unmet(name, job))
-        {
+    for (k, metric) in job.metrics.iter().enumerate() {
+        if let Some(message) = metric.needs().iter().find_map(|need| need.unmet(metric.name(), job)) {
             return Err((format!("metrics[{k}]"), message));
         }
     }
@@ -393,4 +343,35 @@ pub fn check_job(job: &JobSpec) -> Result<(), (String, String)> {
         ));
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::JobMetric;
+
+    /// Every metric round-trips through its name, in Rust, JSON (`job.json`, whose text makes the job id) and the
+    /// schema; names are unique.
+    #[test]
+    fn every_metric_round_trips_through_its_name() {
+        let mut seen = std::collections::HashSet::new();
+        for &metric in JobMetric::ALL {
+            assert!(seen.insert(metric.name()), "`{}` twice", metric.name());
+            assert_eq!(JobMetric::from_name(metric.name()), Some(metric));
+            let json = serde_json::to_string(&metric).unwrap();
+            assert_eq!(json, format!("\"{}\"", metric.name()));
+            assert_eq!(serde_json::from_str::<JobMetric>(&json).unwrap(), metric);
+            assert!(!metric.unit().is_empty(), "{}", metric.name());
+            assert!(!metric.description().is_empty(), "{}", metric.name());
+        }
+        assert_eq!(JobMetric::from_name("kinetic_energi_j"), None);
+        let err = serde_json::from_str::<JobMetric>("\"kinetic_energi_j\"").unwrap_err();
+        assert!(err.to_string().contains("unknown metric `kinetic_energi_j`"), "{err}");
+    }
+
+    #[test]
+    fn the_schema_lists_every_name_in_order() {
+        let schema = serde_json::to_value(schemars::schema_for!(JobMetric)).unwrap();
+        let names: Vec<&str> = JobMetric::ALL.iter().map(|m| m.name()).collect();
+        assert_eq!(schema["enum"], serde_json::json!(names), "{schema}");
+    }
 }

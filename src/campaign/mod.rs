@@ -111,7 +111,7 @@ fn expand(
 ) -> Result<Campaign, ConfigError> {
     check_finite(yaml).map_err(|(key, m)| invalid(path, key, m))?;
     check_name(&spec.name).map_err(|m| invalid(path, "name", m))?;
-    metrics::check(&spec).map_err(|(key, m)| invalid(path, key, m))?;
+    let job_metrics = metrics::check(&spec).map_err(|(key, m)| invalid(path, key, m))?;
     if spec.checkpoint.every_steps == 0 {
         return Err(invalid(
             path,
@@ -154,11 +154,11 @@ fn expand(
     let names = sweep::axis_names(&spec.sweep);
     for (k, d) in spec.derived.iter().enumerate() {
         for m in d.required_metrics() {
-            if !spec.metrics.iter().any(|x| x == m) {
+            if !job_metrics.contains(m) {
                 return Err(invalid(
                     path,
                     format!("derived[{k}]"),
-                    format!("needs the metric `{m}` in `metrics`"),
+                    format!("needs the metric `{}` in `metrics`", m.name()),
                 ));
             }
         }
@@ -205,7 +205,7 @@ fn expand(
     // The points as written, to find which value two points that make one job spell differently.
     let written_points = points.clone();
     for (ordinal, point) in points.into_iter().enumerate() {
-        let job = resolve(&spec, &base, point, ordinal, param_keys, path)?;
+        let job = resolve(&spec, &job_metrics, &base, point, ordinal, param_keys, path)?;
         if let Some(&first) = seen.get(&job.job_id) {
             let error = invalid(
                 path,
@@ -334,10 +334,12 @@ fn base_document(spec: &CampaignSpec) -> serde_json::Value {
     serde_json::to_value(&base).expect("a scenario serialises")
 }
 
-/// Applies one sweep point to the base and derives the job's seed and id. `param_keys` gives the key in the campaign
-/// file where each parameter path is set (for messages).
+/// Applies one sweep point to the base and derives the job's seed and id; every job reduces `metrics` (the spec's,
+/// checked by [`metrics::check`]). `param_keys` gives the key in the campaign file where each parameter path is set
+/// (for messages).
 fn resolve(
     spec: &CampaignSpec,
+    metrics: &[metrics::JobMetric],
     base: &serde_json::Value,
     mut point: sweep::Point,
     ordinal: usize,
@@ -399,7 +401,7 @@ fn resolve(
         engine_version: env!("CARGO_PKG_VERSION").to_string(),
         params: point,
         scenario,
-        metrics: spec.metrics.clone(),
+        metrics: metrics.to_vec(),
         analysis: spec.analysis.clone(),
     };
     job.job_id = job.compute_id();
@@ -465,7 +467,7 @@ pub fn validate_jobs<'a>(
         return Ok(());
     };
     let base = base_document(&campaign.spec);
-    let base_job = resolve(&campaign.spec, &base, Vec::new(), 0, &param_keys, path)?;
+    let base_job = resolve(&campaign.spec, &job.metrics, &base, Vec::new(), 0, &param_keys, path)?;
     let base_fails_alike = matches!(
         job_error(&base_job, path),
         Err(ConfigError::Invalid { key: k, message: m, .. }) if k == key && m == message

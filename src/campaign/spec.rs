@@ -16,7 +16,10 @@ pub struct CampaignSpec {
     pub base: ScenarioSpec,
     pub sweep: SweepNode,
     /// Per-job reducers by name (`granflow models` lists them); stored as metrics with units.
+    // Read as text and checked by `metrics::check`, so that an unknown name is reported at its key with a
+    // did-you-mean; the schema still lists the names.
     #[serde(default = "default_metrics")]
+    #[schemars(with = "Vec<crate::campaign::metrics::JobMetric>")]
     pub metrics: Vec<String>,
     /// Settings of the reducers that need them.
     #[serde(default)]
@@ -45,12 +48,16 @@ pub struct CampaignSpec {
 }
 
 fn default_metrics() -> Vec<String> {
-    vec![
-        "kinetic_energy_j".into(),
-        "bed_top_m".into(),
-        "mean_height_m".into(),
-        "coordination_number".into(),
+    use super::metrics::JobMetric;
+    [
+        JobMetric::KineticEnergy,
+        JobMetric::BedTop,
+        JobMetric::MeanHeight,
+        JobMetric::CoordinationNumber,
     ]
+    .iter()
+    .map(|m| m.name().to_string())
+    .collect()
 }
 
 fn default_max_jobs() -> usize {

@@ -5,16 +5,16 @@
 //! database lacks, ingest any `result.json` that finished while nobody was listening, put jobs left `running` by a
 //! dead dispatcher back to `pending`, then work through the pending jobs in sweep order.
 //!
-//! Failure classes and what happens (`RetryPolicy` gives the budgets): config → failed at once; numerical, crash,
-//! killed, timeout, lost → retried from the job's last checkpoint while the class's budget lasts; preempted (the
-//! worker checkpointed and stopped on a signal) → requeued without using an attempt.
+//! Failure classes ([`FailureClass`]) and what happens ([`retry_rule`]; `RetryPolicy` gives the budgets): config →
+//! failed at once; numerical, crash, killed, timeout, lost → retried from the job's last checkpoint while the
+//! class's budget lasts; preempted (the worker checkpointed and stopped on a signal), interrupted (the dispatcher
+//! stopped it) and locked (another worker held the job) → requeued without using an attempt.
 //!
 //! Ctrl-C (SIGINT) or SIGTERM once: no new jobs start, running workers are asked to checkpoint and stop, and the
 //! dispatcher exits when they have; twice: workers are killed at once. Workers are started with `--watch-stdin` on a
 //! pipe only the dispatcher holds, so if the dispatcher dies in any way they stop immediately.
 
 use std::collections::{BTreeMap, HashMap, VecDeque};
-use std::fs::File;
 use std::path::{Path, PathBuf};
 use std::process::Stdio;
 use std::time::{Duration, Instant};
@@ -24,13 +24,14 @@ use tokio::process::{Child, ChildStdin, Command};
 use tokio::sync::mpsc;
 
 use super::progress::Progress;
-use super::protocol::{Event, Message};
 use crate::campaign::spec::{ExecutorSpec, RetryPolicy};
 use crate::campaign::{self, Campaign, JobSpec};
+use crate::campaign_dir::{self, database_path, job_dir, job_spec_path, result_path, spec_copy_path, worker_log_path};
 use crate::error::Error;
-use crate::simulate::write_atomic;
-use crate::store::{self, AfterFailure, JobStatus, NewJob, ParamValue, Store};
+use crate::store::{self, AfterFailure, FailureClass, JobStatus, NewJob, ParamValue, Store};
+use crate::util::write_atomic;
 use crate::worker;
+use crate::worker::protocol::{Event, Message};
 
 /// How to run a campaign (command-line overrides of the campaign's executor settings).
 #[derive(Debug, Clone, Default)]
@@ -52,11 +53,6 @@ pub struct Outcome {
     pub interrupted: bool,
     /// Jobs whose results were ingested in this invocation.
     pub ingested: usize,
-}
-
-/// The campaign database of an output directory.
-pub fn database_path(out: &Path) -> PathBuf {
-    out.join("campaign.sqlite")
 }
 
 /// `asked` jobs at once, or fewer when that many of the campaign's largest job would need more than the machine's
@@ -86,16 +82,6 @@ fn parallel_within_memory(campaign: &Campaign, asked: usize) -> usize {
     fits.min(asked)
 }
 
-/// The campaign directory's copy of the campaign file (what `resume` runs).
-pub fn spec_copy_path(out: &Path) -> PathBuf {
-    out.join("campaign.yaml")
-}
-
-/// The directory of one job.
-pub fn job_dir(out: &Path, job_id: &str) -> PathBuf {
-    out.join("jobs").join(job_id)
-}
-
 fn store_err(e: store::StoreError) -> Error {
     Error::External(e.to_string())
 }
@@ -106,20 +92,20 @@ pub fn run_campaign(campaign: &Campaign, source: &Path, out: &Path, opts: &Dispa
     let unfinished: Vec<&JobSpec> = campaign
         .jobs
         .iter()
-        .filter(|j| !job_dir(out, &j.job_id).join("result.json").exists())
+        .filter(|j| !result_path(&job_dir(out, &j.job_id)).exists())
         .collect();
     campaign::validate_jobs(campaign, unfinished.iter().copied(), source)?;
     if !opts.force {
         check_no_orphans(campaign, source, out)?;
     }
 
-    std::fs::create_dir_all(out.join("jobs")).map_err(|e| Error::io("create directory", out, e))?;
-    let _lock = lock_campaign(out)?;
+    std::fs::create_dir_all(campaign_dir::jobs_path(out)).map_err(|e| Error::io("create directory", out, e))?;
+    let _lock = campaign_dir::lock(out)?;
     let copy = spec_copy_path(out);
     if std::fs::read_to_string(&copy).ok().as_deref() != Some(campaign.yaml.as_str()) {
         write_atomic(&copy, campaign.yaml.as_bytes())?;
     }
-    let _log_guard = super::log::init(&out.join("campaign.log"));
+    let _log_guard = super::log::init(&campaign_dir::log_path(out));
     tracing::info!(campaign = %campaign.spec.name, jobs = campaign.jobs.len(), "dispatcher started");
 
     let mut store = Store::open(database_path(out)).map_err(store_err)?;
@@ -166,7 +152,7 @@ pub fn run_campaign(campaign: &Campaign, source: &Path, out: &Path, opts: &Dispa
     let mut queue = VecDeque::new();
     for job in &campaign.jobs {
         let dir = job_dir(out, &job.job_id);
-        let job_json = dir.join("job.json");
+        let job_json = job_spec_path(&dir);
         if !job_json.exists() {
             std::fs::create_dir_all(&dir).map_err(|e| Error::io("create directory", &dir, e))?;
             let text = serde_json::to_string_pretty(job).expect("job specs serialise");
@@ -342,29 +328,14 @@ fn store_result(store: &mut Store, job_id: &str, result: &worker::JobResult, fin
     store.finish_job(job_id, &stored).map_err(store_err)
 }
 
-/// Takes the campaign directory's lock (held while the returned file is open): one dispatcher, or one `reduce`, at a
-/// time.
-fn lock_campaign(dir: &Path) -> Result<File, Error> {
-    let lock_path = dir.join("campaign.lock");
-    let lock = File::create(&lock_path).map_err(|e| Error::io("create", &lock_path, e))?;
-    match lock.try_lock() {
-        Ok(()) => Ok(lock),
-        Err(std::fs::TryLockError::WouldBlock) => Err(Error::External(format!(
-            "another dispatcher is running this campaign ({} is locked)",
-            lock_path.display()
-        ))),
-        Err(std::fs::TryLockError::Error(e)) => Err(Error::io("lock", &lock_path, e)),
-    }
-}
-
 /// `granflow reduce <dir>`: recomputes the metrics of every finished job of the campaign in `dir` with this build's
 /// reducers (`worker::rereduce`), replaces them in the database (the jobs keep their finish times) and recomputes
 /// the derived metrics. Holds the campaign lock, so it cannot run beside a dispatcher. Returns how many jobs.
 pub fn reduce_campaign_again(dir: &Path) -> Result<usize, Error> {
-    let campaign = crate::inspect::load_stored_campaign(dir)?;
-    let _lock = lock_campaign(dir)?;
+    let campaign = campaign_dir::load_stored_campaign(dir)?;
+    let _lock = campaign_dir::lock(dir)?;
     let mut store = Store::open(database_path(dir)).map_err(store_err)?;
-    let campaign_id = crate::inspect::stored_campaign_id(&store, &campaign, dir)?;
+    let campaign_id = campaign_dir::stored_campaign_id(&store, &campaign, dir)?;
     let done: Vec<(String, f64)> = store
         .job_summaries(campaign_id)
         .map_err(store_err)?
@@ -399,7 +370,7 @@ struct Running {
     started: Instant,
     last_heard: Instant,
     /// Why the dispatcher stopped it, if it did (timeout, lost, interrupted).
-    stopped_for: Option<&'static str>,
+    stopped_for: Option<FailureClass>,
     last_error: Option<String>,
 }
 
@@ -413,7 +384,7 @@ async fn dispatch(
     store: &mut Store,
     mut queue: VecDeque<JobSpec>,
     mut attempts: HashMap<String, u32>,
-    mut retries_used: HashMap<(String, String), u32>,
+    mut retries_used: HashMap<(String, FailureClass), u32>,
     labels: &HashMap<String, String>,
     settings: &Settings,
     mut progress: Progress,
@@ -433,7 +404,7 @@ async fn dispatch(
             attempts.insert(job.job_id.clone(), attempt);
             let dt_halvings = if settings.retry.halve_dt_on_numerical {
                 retries_used
-                    .get(&(job.job_id.clone(), "numerical".to_string()))
+                    .get(&(job.job_id.clone(), FailureClass::Numerical))
                     .copied()
                     .unwrap_or(0)
             } else {
@@ -490,7 +461,7 @@ async fn dispatch(
                             progress.progress(&job_id, step, total_steps, 0.0, 0.0);
                         }
                         Event::Failed { class, error } => {
-                            tracing::warn!(job = %job_id, class, error, "worker reported a failure");
+                            tracing::warn!(job = %job_id, class = class.as_str(), error, "worker reported a failure");
                             r.last_error = Some(error);
                         }
                         Event::Checkpointed { .. } | Event::Finished { .. } | Event::Stopped { .. } => {}
@@ -511,25 +482,24 @@ async fn dispatch(
                             tracing::warn!(job = %job_id, error = %e, "unreadable result");
                         }
                     }
-                    let class: &'static str = r.stopped_for.unwrap_or_else(|| worker::exit_class(code));
+                    let class = r.stopped_for.unwrap_or_else(|| worker::protocol::exit_class(code));
                     let error = r.last_error.clone().unwrap_or_else(|| match code {
-                        Some(c) => format!("worker exited with code {c} without a result (see {}/worker.log)", dir.display()),
-                        None => format!("worker was killed by a signal (see {}/worker.log)", dir.display()),
+                        Some(c) => format!("worker exited with code {c} without a result (see {})", worker_log_path(&dir).display()),
+                        None => format!("worker was killed by a signal (see {})", worker_log_path(&dir).display()),
                     });
-                    let after = match class {
-                        "preempted" | "interrupted" | "locked" => AfterFailure::Retry,
-                        "config" => AfterFailure::Final,
-                        other => {
-                            let used = retries_used.entry((job_id.clone(), other.to_string())).or_insert(0);
-                            let budget = budget(&settings.retry, other);
+                    let after = match retry_rule(&settings.retry, class) {
+                        RetryRule::Free => AfterFailure::Retry,
+                        RetryRule::Never => AfterFailure::Final,
+                        RetryRule::Budget(budget) => {
+                            let used = retries_used.entry((job_id.clone(), class)).or_insert(0);
                             if *used < budget { *used += 1; AfterFailure::Retry } else { AfterFailure::Final }
                         }
                     };
                     store.mark_failed(&job_id, r.attempt, class, &error, store::unix_time_s(), after).map_err(store_err)?;
-                    tracing::warn!(job = %job_id, class, error, retry = matches!(after, AfterFailure::Retry), "attempt ended without a result");
+                    tracing::warn!(job = %job_id, class = class.as_str(), error, retry = matches!(after, AfterFailure::Retry), "attempt ended without a result");
                     match after {
                         AfterFailure::Retry if interrupts == 0 => {
-                            if class == "locked" {
+                            if class == FailureClass::Locked {
                                 // Another worker holds it (a dispatcher that died moments ago): try later.
                                 tokio::time::sleep(Duration::from_millis(200)).await;
                             }
@@ -547,11 +517,11 @@ async fn dispatch(
                     if r.stopped_for.is_some() { continue; }
                     if settings.job_timeout.is_some_and(|t| r.started.elapsed() > t) {
                         tracing::warn!(job = %r.job.job_id, "timeout: asking the worker to checkpoint and stop");
-                        r.stopped_for = Some("timeout");
+                        r.stopped_for = Some(FailureClass::Timeout);
                         signal(r.child_pid, nix::sys::signal::Signal::SIGTERM);
                     } else if r.last_heard.elapsed() > settings.heartbeat_timeout {
                         tracing::warn!(job = %r.job.job_id, "no heartbeat: killing the worker");
-                        r.stopped_for = Some("lost");
+                        r.stopped_for = Some(FailureClass::Lost);
                         signal(r.child_pid, nix::sys::signal::Signal::SIGKILL);
                     }
                 }
@@ -563,14 +533,28 @@ async fn dispatch(
     Ok(interrupts > 0)
 }
 
-fn budget(policy: &RetryPolicy, class: &str) -> u32 {
+/// What a failed attempt of a class may do: start again without using a retry, or use one of the class's retries.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum RetryRule {
+    /// Requeued without counting: the worker checkpointed and stopped (preempted, interrupted) or never started
+    /// (locked).
+    Free,
+    /// Failed for good at once.
+    Never,
+    /// Requeued while fewer than this many retries of the class have been used (0: failed for good at once).
+    Budget(u32),
+}
+
+/// The retry rule of a failure class under `policy` (a configuration error never retries).
+fn retry_rule(policy: &RetryPolicy, class: FailureClass) -> RetryRule {
     match class {
-        "numerical" => policy.numerical,
-        "crash" => policy.crash,
-        "killed" => policy.killed,
-        "timeout" => policy.timeout,
-        "lost" => policy.lost,
-        _ => 0,
+        FailureClass::Preempted | FailureClass::Interrupted | FailureClass::Locked => RetryRule::Free,
+        FailureClass::Config => RetryRule::Never,
+        FailureClass::Numerical => RetryRule::Budget(policy.numerical),
+        FailureClass::Crash => RetryRule::Budget(policy.crash),
+        FailureClass::Killed => RetryRule::Budget(policy.killed),
+        FailureClass::Timeout => RetryRule::Budget(policy.timeout),
+        FailureClass::Lost => RetryRule::Budget(policy.lost),
     }
 }
 
@@ -580,7 +564,7 @@ fn interrupt(running: &mut BTreeMap<String, Running>, before: u32, progress: &mu
         progress.message("interrupted: workers are checkpointing and stopping (Ctrl-C again to kill them)");
         tracing::warn!("interrupted: stopping workers");
         for r in running.values_mut() {
-            r.stopped_for = Some("interrupted");
+            r.stopped_for = Some(FailureClass::Interrupted);
             signal(r.child_pid, nix::sys::signal::Signal::SIGTERM);
         }
     } else {
@@ -626,7 +610,7 @@ fn spawn(
 ) -> Result<(Option<u32>, Option<ChildStdin>), Error> {
     let dir = job_dir(&settings.out, &job.job_id);
     let exe = own_executable()?;
-    let log_path = dir.join("worker.log");
+    let log_path = worker_log_path(&dir);
     let log = std::fs::OpenOptions::new()
         .create(true)
         .append(true)
@@ -665,4 +649,41 @@ fn spawn(
         let _ = tx.send(FromWorker::Exited(job_id, code));
     });
     Ok((pid, stdin))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::{RetryRule, retry_rule};
+    use crate::campaign::spec::RetryPolicy;
+    use crate::store::FailureClass;
+
+    #[test]
+    fn each_failure_class_has_its_retry_rule() {
+        let policy = RetryPolicy {
+            numerical: 1,
+            crash: 2,
+            killed: 3,
+            timeout: 4,
+            lost: 5,
+            halve_dt_on_numerical: true,
+        };
+        let rules: Vec<(FailureClass, RetryRule)> = FailureClass::ALL
+            .into_iter()
+            .map(|c| (c, retry_rule(&policy, c)))
+            .collect();
+        assert_eq!(
+            rules,
+            [
+                (FailureClass::Config, RetryRule::Never),
+                (FailureClass::Numerical, RetryRule::Budget(1)),
+                (FailureClass::Crash, RetryRule::Budget(2)),
+                (FailureClass::Killed, RetryRule::Budget(3)),
+                (FailureClass::Timeout, RetryRule::Budget(4)),
+                (FailureClass::Lost, RetryRule::Budget(5)),
+                (FailureClass::Preempted, RetryRule::Free),
+                (FailureClass::Interrupted, RetryRule::Free),
+                (FailureClass::Locked, RetryRule::Free),
+            ]
+        );
+    }
 }

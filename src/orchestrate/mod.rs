@@ -1,7 +1,8 @@
-//! Running a campaign: the dispatcher (the only database writer), the protocol its workers speak, progress display
-//! and the campaign log.
+//! Running a campaign: the dispatcher (the only database writer), progress display and the campaign log.
+//!
+//! What does not live here: the protocol the workers speak (`crate::worker::protocol`), the campaign directory's
+//! layout (`crate::campaign_dir`) and the database (`crate::store`).
 
 pub mod dispatcher;
 mod log;
 mod progress;
-pub mod protocol;

@@ -1,5 +1,8 @@
 //! Scenarios: one simulation described in YAML (`granflow simulate <scenario.yaml>`), validated and turned into the
-//! engine's configuration and initial particles. The campaign layer will embed the same spec as its `base`.
+//! engine's configuration and initial particles. A campaign file embeds the same spec as its `base`.
+//!
+//! What does not live here: sweeps and jobs (`crate::campaign`), and the closest-name search behind the "did you
+//! mean" of unknown keys (`crate::util::did_you_mean`).
 
 mod build;
 pub mod gas;
@@ -133,7 +136,7 @@ pub fn with_suggestion(message: String) -> String {
     let word = &rest[..end];
     // After the word: "`, expected one of `a`, `b` at line ..." — the names are every other piece between backticks.
     let known: Vec<&str> = rest[end..].split('`').skip(2).step_by(2).collect();
-    match crate::campaign::sweep::did_you_mean(word, &known) {
+    match crate::util::did_you_mean(word, &known) {
         Some(k) if k != word => format!("{message}; did you mean `{k}`?"),
         _ => message,
     }

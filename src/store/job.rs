@@ -1,8 +1,8 @@
 //! The plain-data types of jobs as the store sees them: what goes in ([`NewJob`], [`JobResult`]), what comes out
 //! ([`JobRow`]) and the closed vocabularies ([`JobStatus`], [`AfterFailure`], [`ParamValue`]).
 //!
-//! What does not live here: how job ids are computed and what the failure classes (`exit_class`) are; the store
-//! keeps the caller's strings.
+//! What does not live here: how job ids are computed, and the failure classes of `exit_class`
+//! ([`FailureClass`](super::FailureClass), in its own file).
 
 use std::cmp::Ordering;
 use std::fmt;
@@ -171,7 +171,8 @@ pub struct JobRow {
     pub status: JobStatus,
     /// Current or last attempt; 0 = never started.
     pub attempt: u32,
-    pub exit_class: Option<String>,
+    /// Why the last attempt ended without a result (cleared when the job starts again or finishes).
+    pub exit_class: Option<super::FailureClass>,
     pub error: Option<String>,
     pub host: Option<String>,
     pub started_at: Option<f64>,

@@ -4,7 +4,7 @@
 //!
 //! All writers are idempotent where a crashed dispatcher may repeat them: registering known jobs leaves them alone,
 //! and ingesting the same result twice replaces it. What does not live here: the retry policy (the caller says
-//! whether a failure is final, [`AfterFailure`]) and the failure classes (`exit_class` is the caller's string).
+//! whether a failure is final, [`AfterFailure`]) and which [`FailureClass`] an attempt ended with.
 
 use std::collections::HashSet;
 use std::path::Path;
@@ -13,6 +13,7 @@ use rusqlite::{Connection, TransactionBehavior, params};
 
 use super::Store;
 use super::error::{Context, StoreError};
+use super::failure_class::FailureClass;
 use super::job::{AfterFailure, JobResult, JobStatus, NewJob, ParamValue};
 
 impl Store {
@@ -147,7 +148,7 @@ impl Store {
         &mut self,
         job_id: &str,
         attempt: u32,
-        exit_class: &str,
+        exit_class: FailureClass,
         error: &str,
         at: f64,
         after: AfterFailure,
@@ -499,14 +500,21 @@ mod tests {
 
         store.mark_running(a, 1, "node1", 1.0, "0.1.0+test").unwrap();
         store
-            .mark_failed(a, 1, "numerical", "non-finite velocity", 2.0, AfterFailure::Retry)
+            .mark_failed(
+                a,
+                1,
+                FailureClass::Numerical,
+                "non-finite velocity",
+                2.0,
+                AfterFailure::Retry,
+            )
             .unwrap();
         let row = &store.job_summaries(campaign).unwrap()[0];
         assert_eq!(row.status, JobStatus::Pending);
-        assert_eq!(row.exit_class.as_deref(), Some("numerical"));
+        assert_eq!(row.exit_class, Some(FailureClass::Numerical));
         store.mark_running(a, 2, "node2", 3.0, "0.1.0+test").unwrap();
         store
-            .mark_failed(a, 2, "crash", "signal 9", 4.0, AfterFailure::Final)
+            .mark_failed(a, 2, FailureClass::Crash, "signal 9", 4.0, AfterFailure::Final)
             .unwrap();
         let row = &store.job_summaries(campaign).unwrap()[0];
         assert_eq!(

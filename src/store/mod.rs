@@ -5,13 +5,15 @@
 //! user_version`. The dispatcher is the single writer ([`Store::open`], WAL mode); `granflow query`, `status` and
 //! `export` read through [`Store::open_read_only`] while a campaign runs. Every write that touches several rows is one
 //! transaction, and re-ingesting a result replaces it, so a dispatcher that crashes and reconciles never duplicates
-//! data. What does not live here: deciding what a job is (campaign expansion, job ids), retry policy (which failures
-//! are final) and reading `result.json`; callers pass those decisions in.
+//! data. What does not live here: deciding what a job is (campaign expansion, job ids), which failure class an
+//! attempt ended with and the retry policy (which failures are final), and reading `result.json`; callers pass those
+//! decisions in.
 //!
 //! Timestamps are unix seconds as `f64` (see [`unix_time_s`]).
 
 mod campaign;
 mod error;
+mod failure_class;
 mod job;
 mod lifecycle;
 mod migrations;
@@ -30,6 +32,7 @@ use rusqlite::{Connection, OpenFlags};
 pub use campaign::Campaign;
 use error::Context;
 pub use error::StoreError;
+pub use failure_class::FailureClass;
 pub use job::{AfterFailure, JobResult, JobRow, JobStatus, Metric, NewJob, ParamValue};
 pub use migrations::SCHEMA_VERSION;
 pub use pivot::{Pivot, PivotCell};

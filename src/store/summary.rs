@@ -10,6 +10,7 @@ use serde_json::Value;
 
 use super::Store;
 use super::error::{Context, StoreError};
+use super::failure_class::FailureClass;
 use super::job::{JobRow, JobStatus, ParamValue};
 use super::render::json_real;
 
@@ -73,7 +74,7 @@ impl Store {
 
     /// Retries already used, per (job, failure class): attempts that ended `requeued` with that class. The
     /// dispatcher starts from these counts, so a retry budget is not renewed by restarting the dispatcher.
-    pub fn retries_used(&self, campaign_id: i64) -> Result<HashMap<(String, String), u32>, StoreError> {
+    pub fn retries_used(&self, campaign_id: i64) -> Result<HashMap<(String, FailureClass), u32>, StoreError> {
         let action = format_args!("counting the retries of campaign {campaign_id}");
         let mut stmt = self
             .conn
@@ -85,7 +86,7 @@ impl Store {
             .context(&self.path, action)?;
         stmt.query_map([campaign_id], |row| {
             Ok((
-                (row.get::<_, String>(0)?, row.get::<_, String>(1)?),
+                (row.get::<_, String>(0)?, row.get::<_, FailureClass>(1)?),
                 row.get::<_, i64>(2)?.max(0) as u32,
             ))
         })

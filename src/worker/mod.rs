@@ -3,13 +3,14 @@
 //! The worker owns the directory and never touches the database. It takes the directory's lock (two workers never
 //! run one job), resumes from the newest valid checkpoint if there is one, runs to the end with checkpoints at the
 //! campaign's cadence, reduces the metrics, writes `series.h5` and finally `result.json` (atomically, last: its
-//! presence means done). It reports on stdout in JSON lines (`orchestrate::protocol`).
+//! presence means done). It reports on stdout in JSON lines ([`protocol`]).
 //!
 //! Stopping: SIGTERM or SIGINT make it checkpoint at the next chunk boundary and exit with `EXIT_PREEMPTED`. With
 //! `--watch-stdin` (how the dispatcher starts it) it exits at once with `EXIT_ORPHANED` when its stdin closes, which
 //! happens when the dispatcher dies, even by `kill -9`; whatever it computed since its last checkpoint is lost, and
 //! nothing is corrupted, since every file it writes is written to a temporary name and renamed.
 
+pub mod protocol;
 mod reduce;
 pub mod rereduce;
 mod series_h5;
@@ -24,9 +25,12 @@ use std::time::Instant;
 use serde::{Deserialize, Serialize};
 
 use crate::campaign::JobSpec;
-use crate::error::{EXIT_CONFIG, EXIT_IO, EXIT_NUMERICAL, Error};
-use crate::orchestrate::protocol::{EXIT_LOCKED, EXIT_ORPHANED, EXIT_PREEMPTED, Event, Message};
-use crate::simulate::{RunControl, RunEvent, RunObserver, run_in_dir, write_atomic};
+use crate::campaign_dir::{job_spec_path, result_path, worker_lock_path};
+use crate::error::Error;
+use crate::simulate::{RunControl, RunEvent, RunObserver, run_in_dir};
+use crate::store::FailureClass;
+use crate::util::write_atomic;
+use protocol::{EXIT_LOCKED, EXIT_ORPHANED, EXIT_PREEMPTED, Event, Message};
 
 pub use reduce::Metric;
 
@@ -82,12 +86,12 @@ pub fn run_worker(opts: &WorkerOptions) -> i32 {
         Ok(code) => code,
         Err(e) => {
             let class = match &e {
-                Error::Config(_) => "config",
-                Error::Numerical(_) => "numerical",
-                _ => "crash",
+                Error::Config(_) => FailureClass::Config,
+                Error::Numerical(_) => FailureClass::Numerical,
+                _ => FailureClass::Crash,
             };
             emit(Event::Failed {
-                class: class.into(),
+                class,
                 error: e.to_string(),
             });
             eprintln!("error: {e}");
@@ -98,14 +102,14 @@ pub fn run_worker(opts: &WorkerOptions) -> i32 {
 
 fn run(opts: &WorkerOptions) -> Result<i32, Error> {
     let dir = &opts.job_dir;
-    let lock_path = dir.join("worker.lock");
+    let lock_path = worker_lock_path(dir);
     let lock = File::create(&lock_path).map_err(|e| Error::io("create", &lock_path, e))?;
     match lock.try_lock() {
         Ok(()) => {}
         Err(std::fs::TryLockError::WouldBlock) => {
             let msg = format!("{} is locked by another worker", dir.display());
             emit(Event::Failed {
-                class: "locked".into(),
+                class: FailureClass::Locked,
                 error: msg.clone(),
             });
             eprintln!("error: {msg}");
@@ -132,12 +136,12 @@ fn run(opts: &WorkerOptions) -> Result<i32, Error> {
     }
 
     let job = read_job(dir)?;
-    let result_path = dir.join("result.json");
+    let result_path = result_path(dir);
     if result_path.exists() {
         emit(Event::Finished { wall_time_s: 0.0 });
         return Ok(0);
     }
-    let built = crate::scenario::build(job.scenario.clone(), &dir.join("job.json"))?;
+    let built = crate::scenario::build(job.scenario.clone(), &job_spec_path(dir))?;
     let start = Instant::now();
     let mut observer = WorkerObserver::new(&job, &built)?;
     let (summary, sim) = run_in_dir(
@@ -159,7 +163,7 @@ fn run(opts: &WorkerOptions) -> Result<i32, Error> {
     let simulate_s = start.elapsed().as_secs_f64();
     let t_reduce = Instant::now();
     let series = reduce::Series::read(&dir.join("series.csv"))?;
-    let metrics = reduce::metrics(&job, &built, &sim, &series)?;
+    let metrics = reduce::metrics(&job, &built, &sim, &series);
     series_h5::write(&dir.join("series.h5"), &series)?;
     let reduce_s = t_reduce.elapsed().as_secs_f64();
     let result = JobResult {
@@ -192,7 +196,7 @@ fn run(opts: &WorkerOptions) -> Result<i32, Error> {
 
 /// Reads and checks `job.json` (its id must match its content).
 pub fn read_job(dir: &Path) -> Result<JobSpec, Error> {
-    let path = dir.join("job.json");
+    let path = job_spec_path(dir);
     let text = std::fs::read_to_string(&path).map_err(|e| Error::io("read", &path, e))?;
     let job: JobSpec = serde_json::from_str(&text)
         .map_err(|e| Error::External(format!("{}: not a job description: {e}", path.display())))?;
@@ -208,7 +212,7 @@ pub fn read_job(dir: &Path) -> Result<JobSpec, Error> {
 
 /// Reads `result.json` of a job directory, if it is there and well formed.
 pub fn read_result(dir: &Path) -> Result<Option<JobResult>, Error> {
-    let path = dir.join("result.json");
+    let path = result_path(dir);
     match std::fs::read_to_string(&path) {
         Ok(text) => serde_json::from_str(&text)
             .map(Some)
@@ -278,19 +282,5 @@ impl RunObserver for WorkerObserver {
             }),
             RunEvent::Checkpointed { step } => emit(Event::Checkpointed { step }),
         }
-    }
-}
-
-/// Exit code → failure class, for a worker that ended without a result.
-pub fn exit_class(code: Option<i32>) -> &'static str {
-    match code {
-        Some(EXIT_CONFIG) => "config",
-        Some(EXIT_NUMERICAL) => "numerical",
-        Some(EXIT_PREEMPTED) => "preempted",
-        Some(EXIT_LOCKED) => "locked",
-        Some(EXIT_ORPHANED) => "killed",
-        Some(EXIT_IO) => "crash",
-        Some(_) => "crash",
-        None => "killed",
     }
 }

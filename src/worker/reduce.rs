@@ -1,4 +1,8 @@
-//! The per-job reducers: final-state metrics from the simulation, time-series metrics from `series.csv`.
+//! The per-job reducers: final-state metrics from the simulation, time-series metrics from `series.csv`. Which
+//! metrics exist, their names, units and needs are `crate::campaign::metrics`' table; [`metrics`] computes each
+//! one in a single `match` over [`JobMetric`].
+//!
+//! What does not live here: checking that a job can have a metric (done before it runs, `campaign::metrics`).
 
 use std::path::Path;
 
@@ -6,7 +10,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::analysis;
 use crate::campaign::JobSpec;
-use crate::campaign::metrics::info;
+use crate::campaign::metrics::JobMetric;
 use crate::campaign::spec::CyclePressure;
 use crate::engine::models::cohesion_law::CohesionModel;
 use crate::engine::particles::SpeciesId;
@@ -141,8 +145,8 @@ impl Series {
     }
 }
 
-/// Every metric the job asks for.
-pub fn metrics(job: &JobSpec, built: &BuiltScenario, sim: &Simulation, series: &Series) -> Result<Vec<Metric>, Error> {
+/// Every metric the job asks for, in its order.
+pub fn metrics(job: &JobSpec, built: &BuiltScenario, sim: &Simulation, series: &Series) -> Vec<Metric> {
     let sampler = MixingSampler::new(job, built);
     let mixing_final = sampler.as_ref().map(|s| s.state(sim));
     // (t, IS, Lacey) at the sampled rows.
@@ -162,78 +166,91 @@ pub fn metrics(job: &JobSpec, built: &BuiltScenario, sim: &Simulation, series: &
     // The cycle is read once for all the cycle metrics that ask for it.
     let cycle_once = std::cell::OnceCell::new();
     let cycle = || cycle_once.get_or_init(|| cycle(job, built, sim, series)).as_ref();
-    let mut out = Vec::new();
-    for name in &job.metrics {
-        let meta = info(name).ok_or_else(|| Error::External(format!("unknown metric `{name}`")))?;
-        let value = match name.as_str() {
-            "kinetic_energy_j" => sim.particles.kinetic_energy_j(),
-            "translational_kinetic_energy_j" => sim.particles.translational_kinetic_energy_j(),
-            "bed_top_m" => sim.bed_height_m().0,
-            "mean_height_m" => sim.bed_height_m().1,
-            "coordination_number" => {
-                let (pairs, _) = sim.contact_counts();
-                analysis::mean_coordination_number(sim.particles.len(), pairs)
+    job.metrics
+        .iter()
+        .map(|&metric| {
+            let value = match metric {
+                JobMetric::KineticEnergy => sim.particles.kinetic_energy_j(),
+                JobMetric::TranslationalKineticEnergy => sim.particles.translational_kinetic_energy_j(),
+                JobMetric::BedTop => sim.bed_height_m().0,
+                JobMetric::MeanHeight => sim.bed_height_m().1,
+                JobMetric::CoordinationNumber => {
+                    let (pairs, _) = sim.contact_counts();
+                    analysis::mean_coordination_number(sim.particles.len(), pairs)
+                }
+                JobMetric::GranularTemperature => layered_granular_temperature(sim),
+                JobMetric::IntensityOfSegregation => {
+                    mixing_final.as_ref().map_or(f64::NAN, |m| m.intensity_of_segregation)
+                }
+                JobMetric::LaceyIndex => mixing_final.as_ref().map_or(f64::NAN, |m| m.lacey_index),
+                JobMetric::MixingRateConstant => mixing_series()
+                    .and_then(|(t, is, _)| analysis::fit::fit_exponential_decay(&t, &is))
+                    .map_or(f64::NAN, |f| f.rate_constant_per_s),
+                JobMetric::MixingRateToRandom => {
+                    let random = random_mixture_intensity(job, sim);
+                    mixing_series()
+                        .and_then(|(t, is, _)| analysis::fit::fit_exponential_decay_to(&t, &is, random))
+                        .map_or(f64::NAN, |f| f.rate_constant_per_s)
+                }
+                JobMetric::TimeTo90PctMaxLacey => mixing_series()
+                    .and_then(|(t, _, lacey)| analysis::fit::time_to_fraction_of_max(&t, &lacey, 0.9))
+                    .map_or(f64::NAN, |t| t),
+                JobMetric::MeanHeightTimeAverage => {
+                    window(series, "mean_height_m", average_from_s).map_or(f64::NAN, |w| mean(&w))
+                }
+                JobMetric::BedWeightPerArea => bed_weight_per_area_pa(built, sim),
+                JobMetric::CoordinationNumberTimeAverage => {
+                    window(series, "mean_coordination", average_from_s).map_or(f64::NAN, |w| mean(&w))
+                }
+                JobMetric::PressureDropMean => {
+                    window(series, "column_pressure_drop_pa", average_from_s).map_or(f64::NAN, |w| mean(&w))
+                }
+                JobMetric::PressureDropStd => {
+                    window(series, "column_pressure_drop_pa", average_from_s).map_or(f64::NAN, |w| std_dev(&w))
+                }
+                JobMetric::ProbePressureDropMean => {
+                    window(series, "probe_pressure_drop_pa", average_from_s).map_or(f64::NAN, |w| mean(&w))
+                }
+                JobMetric::GranularBondNumber
+                | JobMetric::GranularBondNumber22
+                | JobMetric::GranularBondNumber12
+                | JobMetric::GranularCapillaryNumber
+                | JobMetric::GranularCapillaryNumber22
+                | JobMetric::GranularCapillaryNumber12
+                | JobMetric::WetPhaseMixed => wet_number(metric, job, built, sim),
+                JobMetric::CoatingVariability => crate::engine::spray::coating_variability(&sim.particles.sprayed_m3),
+                JobMetric::DefluidizationVelocity => cycle().map_or(f64::NAN, |c| c.velocities.defluidization_m_per_s),
+                JobMetric::FluidizationVelocityTheoretical => {
+                    cycle().map_or(f64::NAN, |c| c.velocities.fluidization_theoretical_m_per_s)
+                }
+                JobMetric::IncipientFluidizationVelocity => {
+                    cycle().map_or(f64::NAN, |c| c.velocities.incipient_m_per_s)
+                }
+                JobMetric::PressureOvershootRatio => cycle().map_or(f64::NAN, |c| c.velocities.overshoot_ratio),
+                JobMetric::OvershootFluidForcePerWeight => {
+                    overshoot_net_force(NetForcePart::Fluid, cycle(), sim, series)
+                }
+                JobMetric::OvershootDistributorContactPerWeight => {
+                    overshoot_net_force(NetForcePart::DistributorContact, cycle(), sim, series)
+                }
+                JobMetric::OvershootDistributorCohesionPerWeight => {
+                    overshoot_net_force(NetForcePart::DistributorCohesion, cycle(), sim, series)
+                }
+                JobMetric::OvershootSidewallFrictionPerWeight => {
+                    overshoot_net_force(NetForcePart::SidewallFriction, cycle(), sim, series)
+                }
+                JobMetric::OvershootSidewallNormalLoadPerWeight => {
+                    overshoot_net_force(NetForcePart::SidewallNormalLoad, cycle(), sim, series)
+                }
+                JobMetric::SteppedFluidizationVelocity => stepped_onset_m_per_s(job, built, sim, series),
+            };
+            Metric {
+                name: metric.name().to_string(),
+                value,
+                unit: metric.unit().to_string(),
             }
-            "granular_temperature_m2_per_s2" => layered_granular_temperature(sim),
-            "intensity_of_segregation" => mixing_final.as_ref().map_or(f64::NAN, |m| m.intensity_of_segregation),
-            "lacey_index" => mixing_final.as_ref().map_or(f64::NAN, |m| m.lacey_index),
-            "mixing_rate_constant_per_s" => mixing_series()
-                .and_then(|(t, is, _)| analysis::fit::fit_exponential_decay(&t, &is))
-                .map_or(f64::NAN, |f| f.rate_constant_per_s),
-            "mixing_rate_to_random_per_s" => {
-                let random = random_mixture_intensity(job, sim);
-                mixing_series()
-                    .and_then(|(t, is, _)| analysis::fit::fit_exponential_decay_to(&t, &is, random))
-                    .map_or(f64::NAN, |f| f.rate_constant_per_s)
-            }
-            "time_to_90pct_max_lacey_s" => mixing_series()
-                .and_then(|(t, _, lacey)| analysis::fit::time_to_fraction_of_max(&t, &lacey, 0.9))
-                .map_or(f64::NAN, |t| t),
-            "mean_height_time_avg_m" => window(series, "mean_height_m", average_from_s).map_or(f64::NAN, |w| mean(&w)),
-            "bed_weight_per_area_pa" => bed_weight_per_area_pa(built, sim),
-            "coordination_number_time_avg" => {
-                window(series, "mean_coordination", average_from_s).map_or(f64::NAN, |w| mean(&w))
-            }
-            "pressure_drop_mean_pa" => {
-                window(series, "column_pressure_drop_pa", average_from_s).map_or(f64::NAN, |w| mean(&w))
-            }
-            "pressure_drop_std_pa" => {
-                window(series, "column_pressure_drop_pa", average_from_s).map_or(f64::NAN, |w| std_dev(&w))
-            }
-            "probe_pressure_drop_mean_pa" => {
-                window(series, "probe_pressure_drop_pa", average_from_s).map_or(f64::NAN, |w| mean(&w))
-            }
-            wet if wet.starts_with("granular_") || wet == "wet_phase_mixed" => wet_number(wet, job, built, sim),
-            "coating_variability" => crate::engine::spray::coating_variability(&sim.particles.sprayed_m3),
-            "defluidization_velocity_m_per_s" => cycle().map_or(f64::NAN, |c| c.velocities.defluidization_m_per_s),
-            "fluidization_velocity_theoretical_m_per_s" => {
-                cycle().map_or(f64::NAN, |c| c.velocities.fluidization_theoretical_m_per_s)
-            }
-            "incipient_fluidization_velocity_m_per_s" => cycle().map_or(f64::NAN, |c| c.velocities.incipient_m_per_s),
-            "pressure_overshoot_ratio" => cycle().map_or(f64::NAN, |c| c.velocities.overshoot_ratio),
-            "overshoot_fluid_force_per_weight" => overshoot_net_force(NetForcePart::Fluid, cycle(), sim, series),
-            "overshoot_distributor_contact_per_weight" => {
-                overshoot_net_force(NetForcePart::DistributorContact, cycle(), sim, series)
-            }
-            "overshoot_distributor_cohesion_per_weight" => {
-                overshoot_net_force(NetForcePart::DistributorCohesion, cycle(), sim, series)
-            }
-            "overshoot_sidewall_friction_per_weight" => {
-                overshoot_net_force(NetForcePart::SidewallFriction, cycle(), sim, series)
-            }
-            "overshoot_sidewall_normal_load_per_weight" => {
-                overshoot_net_force(NetForcePart::SidewallNormalLoad, cycle(), sim, series)
-            }
-            "stepped_fluidization_velocity_m_per_s" => stepped_onset_m_per_s(job, built, sim, series),
-            other => return Err(Error::External(format!("metric `{other}` has no reducer"))),
-        };
-        out.push(Metric {
-            name: name.clone(),
-            value,
-            unit: meta.unit.to_string(),
-        });
-    }
-    Ok(out)
+        })
+        .collect()
 }
 
 /// The values of a series column from time `from_s` on (`None` if the column is missing or the window empty).
@@ -261,7 +278,7 @@ fn std_dev(v: &[f64]) -> f64 {
 
 /// The granular Bond and capillary numbers of the scenario's liquid and species (1 = the first species, 2 = the
 /// second), and seed 000's phase rule; NaN where the scenario lacks what they need (checked before the run).
-fn wet_number(name: &str, job: &JobSpec, built: &BuiltScenario, sim: &Simulation) -> f64 {
+fn wet_number(metric: JobMetric, job: &JobSpec, built: &BuiltScenario, sim: &Simulation) -> f64 {
     use crate::analysis::dimensionless::{
         GasSlip, WetParticle, WetPhase, binary_granular_bond_number, binary_granular_capillary_number,
         granular_bond_number, granular_capillary_number, wet_phase,
@@ -294,16 +311,16 @@ fn wet_number(name: &str, job: &JobSpec, built: &BuiltScenario, sim: &Simulation
             slip_speed_m_per_s: u / porosity,
             porosity,
         });
-    let value = match (name, b, gas) {
-        ("granular_bond_number", _, _) => Some(granular_bond_number(&a, gamma, g)),
-        ("granular_bond_number_22", Some(b), _) => Some(granular_bond_number(&b, gamma, g)),
-        ("granular_bond_number_12", Some(b), _) => Some(binary_granular_bond_number(&a, &b, gamma, g)),
-        ("granular_capillary_number", _, Some(gas)) => Some(granular_capillary_number(&a, gamma, &gas)),
-        ("granular_capillary_number_22", Some(b), Some(gas)) => Some(granular_capillary_number(&b, gamma, &gas)),
-        ("granular_capillary_number_12", Some(b), Some(gas)) => {
+    let value = match (metric, b, gas) {
+        (JobMetric::GranularBondNumber, _, _) => Some(granular_bond_number(&a, gamma, g)),
+        (JobMetric::GranularBondNumber22, Some(b), _) => Some(granular_bond_number(&b, gamma, g)),
+        (JobMetric::GranularBondNumber12, Some(b), _) => Some(binary_granular_bond_number(&a, &b, gamma, g)),
+        (JobMetric::GranularCapillaryNumber, _, Some(gas)) => Some(granular_capillary_number(&a, gamma, &gas)),
+        (JobMetric::GranularCapillaryNumber22, Some(b), Some(gas)) => Some(granular_capillary_number(&b, gamma, &gas)),
+        (JobMetric::GranularCapillaryNumber12, Some(b), Some(gas)) => {
             Some(binary_granular_capillary_number(&a, &b, gamma, &gas, g))
         }
-        ("wet_phase_mixed", Some(b), Some(gas)) => {
+        (JobMetric::WetPhaseMixed, Some(b), Some(gas)) => {
             let phase = wet_phase(
                 granular_capillary_number(&a, gamma, &gas),
                 granular_capillary_number(&b, gamma, &gas),

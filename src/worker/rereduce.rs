@@ -8,10 +8,12 @@
 use std::path::Path;
 
 use super::{JobResult, read_job, read_result, reduce};
+use crate::campaign_dir::{job_spec_path, result_path};
 use crate::checkpoint::CheckpointSeries;
 use crate::engine::Simulation;
 use crate::error::Error;
-use crate::simulate::{attach_gas, checkpoint_meta, write_atomic};
+use crate::simulate::{attach_gas, checkpoint_meta};
+use crate::util::write_atomic;
 
 /// Recomputes the metrics of the finished job in `job_dir`, writes them into its `result.json` and returns the new
 /// result. Errors name the job directory and what is missing or does not match.
@@ -19,7 +21,7 @@ pub fn reduce_again(job_dir: &Path) -> Result<JobResult, Error> {
     let fail = |what: String| Error::External(format!("{}: {what}", job_dir.display()));
     let job = read_job(job_dir)?;
     let old = read_result(job_dir)?.ok_or_else(|| fail("the job has no result.json (it has not finished)".into()))?;
-    let built = crate::scenario::build(job.scenario.clone(), &job_dir.join("job.json"))?;
+    let built = crate::scenario::build(job.scenario.clone(), &job_spec_path(job_dir))?;
     let meta = checkpoint_meta(&built);
     let loaded = CheckpointSeries::new(job_dir, built.spec.output.keep_checkpoints)
         .latest_valid()?
@@ -43,11 +45,11 @@ pub fn reduce_again(job_dir: &Path) -> Result<JobResult, Error> {
     let series = reduce::Series::read(&job_dir.join("series.csv"))?;
     let this_build = crate::provenance::build_id();
     let result = JobResult {
-        metrics: reduce::metrics(&job, &built, &sim, &series)?,
+        metrics: reduce::metrics(&job, &built, &sim, &series),
         reduced_by: (old.build != this_build).then_some(this_build),
         ..old
     };
     let json = serde_json::to_string_pretty(&result).expect("results serialise");
-    write_atomic(&job_dir.join("result.json"), json.as_bytes())?;
+    write_atomic(&result_path(job_dir), json.as_bytes())?;
     Ok(result)
 }
