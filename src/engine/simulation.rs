@@ -11,13 +11,14 @@ use std::time::{Duration, Instant};
 use super::cohesion::{BridgeCache, CohesionPass, apply_cohesion, total_liquid_m3};
 pub use super::config::SimConfig;
 use super::contacts::AlignedHistory;
-use super::forces::{ForcePass, HalfKick, PairBuffers, RangePlan, add_wall_contact_forces, compute_contact_forces};
 use super::gas::coupled::GasCoupling;
 use super::integrate::{InverseInertia, find_lost, kick_drift};
 use super::models::cohesion_law::{CohesionModel, LiquidBridge};
 use super::neighbor::{Criteria, NeighborList};
 use super::net_force::NetForceTally;
+use super::pair_pass::{ForcePass, HalfKick, PairBuffers, add_wall_contact_forces, compute_contact_forces};
 use super::particles::{ParticleId, Particles};
+use super::range_plan::RangePlan;
 use super::spray::spray_surface;
 use super::state::{RngState, SimState};
 use super::team::Team;
@@ -462,7 +463,7 @@ impl Simulation {
         }
     }
 
-    fn check_overlap(&self, worst: super::forces::WorstOverlap) -> Result<(), NumericalError> {
+    fn check_overlap(&self, worst: super::pair_pass::WorstOverlap) -> Result<(), NumericalError> {
         if worst.ratio > self.config.max_overlap_fraction {
             return Err(NumericalError::ExcessiveOverlap {
                 step: self.step,
