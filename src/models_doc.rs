@@ -64,7 +64,9 @@ cohesion (optional, one of):
                  { ..., spray?, capillary_force?, walls? }               species.liquid_content, contact_angle_deg;
                                                                          capillary_force: auto (Mikami for equal
                                                                          beads at θ = 0, else the Young-Laplace
-                                                                         table) or young_laplace; walls default false
+                                                                         table) or young_laplace; walls default
+                                                                         false (bridges to walls: the sphere-plane
+                                                                         Young-Laplace table)
   hamaker: { constant_j, inner_cutoff_m, outer_cutoff_m, walls? }        seed 001 eqs. 6.34-6.37
   square_well: { depth_j, outer_to_inner_radius_ratio, walls? }          seed 001 eqs. 3.6-3.11 as impulses
 species: { name, radius_m, density_kg_per_m3, youngs_modulus_pa, poisson_ratio, friction_coefficient,

@@ -18,7 +18,26 @@ fn campaign_files(dir: &Path, out: &mut Vec<PathBuf>) {
         let path = entry.unwrap().path();
         if path.is_dir() {
             campaign_files(&path, out);
-        } else if path.extension().is_some_and(|e| e == "yaml" || e == "yml") {
+        } else if path.extension().is_some_and(|e| e == "yaml" || e == "yml") && !is_scenario(&path) {
+            out.push(path);
+        }
+    }
+}
+
+/// A scenario file (a top-level `domain`) rather than a campaign, e.g. research's single runs.
+fn is_scenario(path: &Path) -> bool {
+    let text = std::fs::read_to_string(path).unwrap();
+    let doc: serde_json::Value = serde_norway::from_str(&text).unwrap();
+    doc.get("domain").is_some()
+}
+
+/// The scenario files under `research/`.
+fn research_scenarios(dir: &Path, out: &mut Vec<PathBuf>) {
+    for entry in std::fs::read_dir(dir).unwrap() {
+        let path = entry.unwrap().path();
+        if path.is_dir() {
+            research_scenarios(&path, out);
+        } else if path.extension().is_some_and(|e| e == "yaml" || e == "yml") && is_scenario(&path) {
             out.push(path);
         }
     }
@@ -77,6 +96,11 @@ fn every_committed_job_and_scenario_validates() {
         if file.extension().is_some_and(|e| e == "yaml") {
             granflow::scenario::load(&file).unwrap_or_else(|e| panic!("{}: {e}", file.display()));
         }
+    }
+    let mut research = Vec::new();
+    research_scenarios(&root.join("research"), &mut research);
+    for file in research {
+        granflow::scenario::load(&file).unwrap_or_else(|e| panic!("{}: {e}", file.display()));
     }
 }
 

@@ -58,6 +58,13 @@ pub fn digests(s: &SimState) -> BTreeMap<String, String> {
     d.insert("particles.torque_n_m".into(), vectors(&p.torque_n_m));
     d.insert("particles.liquid_m3".into(), floats(&p.liquid_m3));
     d.insert("particles.sprayed_m3".into(), floats(&p.sprayed_m3));
+    // The channels where a run records them (none of the reference runs does: their digests predate channels).
+    for info in granflow::engine::channels::CHANNELS {
+        let values = (info.get)(&p.channels);
+        if !values.is_empty() {
+            d.insert(format!("particles.channels.{}", info.name), floats(values));
+        }
+    }
     d.insert("walls.angle_rad".into(), floats(&s.wall_angle_rad));
     // Contacts: the records of touching pairs; cohesion: the records with a cohesion state (as the engine kept
     // them in two stores before they became one record per pair).

@@ -129,6 +129,12 @@ job_metrics! {
         "u_mf of a gas.inflow_levels run stepping the gas up: the slowest level of the rising branch from which the bed keeps moving (σ(ΔP) over the second half of each hold ≥ 1 % of W/A) at every faster level; NaN when the levels do not bracket the onset";
     CoatingVariability => "coating_variability", "1", [Spray],
         "CV_m = σ/μ of the liquid each particle received from the spray (seed 000 eq. 6.45)";
+    MeanCollisionDuration => "mean_collision_duration_s", "s", [ContactStatistics],
+        "mean duration of the particle-particle contacts that ended during the run (Hertz: t_c = 2.87 (m*^2/(R* E*^2 v))^(1/5))";
+    MeanWallContactDuration => "mean_wall_contact_duration_s", "s", [ContactStatistics],
+        "mean duration of the particle-wall contacts that ended during the run";
+    WallContactTimeFraction => "wall_contact_time_fraction", "1", [ContactStatistics],
+        "fraction of the run a particle spends touching a wall, mean over the particles";
     ProbePressureDropMean => "probe_pressure_drop_mean_pa", "Pa", [Gas, PressureProbe],
         "time-averaged pressure drop from the inlet to gas.pressure_probe_height_m";
 }
@@ -187,6 +193,8 @@ pub enum Need {
     Spray,
     /// `output.net_forces` (the net force by mechanism in the series).
     NetForces,
+    /// `output.contact_statistics` (contact durations and wall contact times).
+    ContactStatistics,
 }
 
 impl Need {
@@ -201,6 +209,7 @@ impl Need {
             Need::InflowLevels => "gas.inflow_levels",
             Need::Spray => "a spray",
             Need::NetForces => "output.net_forces",
+            Need::ContactStatistics => "output.contact_statistics",
         }
     }
 
@@ -245,6 +254,10 @@ impl Need {
             Need::NetForces => unless(
                 scenario.output.net_forces,
                 format!("`{name}` needs `output.net_forces: true` (the net force by mechanism in the series)"),
+            ),
+            Need::ContactStatistics => unless(
+                scenario.output.contact_statistics,
+                format!("`{name}` needs `output.contact_statistics: true` (contact durations and wall contact times)"),
             ),
         }
     }

@@ -21,6 +21,7 @@ use xxhash_rust::xxh3::Xxh3Default;
 
 use super::{CheckpointError, CheckpointMeta};
 use crate::engine::Vec3;
+use crate::engine::channels::{CHANNELS, ChannelInfo, ParticleChannels};
 use crate::engine::contacts::{ContactStore, WallId};
 use crate::engine::gas::coupled::{GasSnapshot, GasStepStats};
 use crate::engine::models::ContactHistory;
@@ -57,6 +58,8 @@ pub(crate) enum Rows {
     NetForce,
     /// The number of walls when the run sums net forces by mechanism, 0 otherwise.
     NetForceWalls,
+    /// N when the run records the scalar channels (`engine::channels`), 0 otherwise.
+    ParticleChannels,
 }
 
 /// One dataset of the layout.
@@ -129,6 +132,8 @@ macro_rules! datasets {
             /// the table's datasets.
             pub pair_history: HistoryArrays,
             pub wall_history: HistoryArrays,
+            /// The particles' scalar channels (`engine::channels`), visited after the history.
+            pub channels: ParticleChannels,
         }
 
         /// Every dataset of the layout, in checksum order.
@@ -151,7 +156,11 @@ macro_rules! datasets {
                     v.visit(spec, &self.$field)?;
                 )*
                 self.pair_history.visit(HistoryTable::Pairs, v)?;
-                self.wall_history.visit(HistoryTable::Walls, v)
+                self.wall_history.visit(HistoryTable::Walls, v)?;
+                for info in CHANNELS {
+                    v.visit(&channel_spec(info), (info.get)(&self.channels))?;
+                }
+                Ok(())
             }
 
             /// Calls `v` on every dataset in table order, then on the history datasets, letting it fill the arrays.
@@ -162,7 +171,11 @@ macro_rules! datasets {
                     v.visit(spec, &mut self.$field)?;
                 )*
                 self.pair_history.visit_mut(HistoryTable::Pairs, v)?;
-                self.wall_history.visit_mut(HistoryTable::Walls, v)
+                self.wall_history.visit_mut(HistoryTable::Walls, v)?;
+                for info in CHANNELS {
+                    v.visit(&channel_spec(info), (info.get_mut)(&mut self.channels))?;
+                }
+                Ok(())
             }
         }
     };
@@ -197,7 +210,18 @@ impl HistoryTable {
     }
 }
 
-/// Every dataset of a checkpoint: the table's, then the history fields' of pairs and of walls.
+/// The dataset of one scalar channel.
+fn channel_spec(info: &ChannelInfo) -> DatasetSpec {
+    DatasetSpec {
+        path: info.path,
+        rows: Rows::ParticleChannels,
+        width: 1,
+        units: info.unit,
+        dtype: <f64 as Element>::NAME,
+    }
+}
+
+/// Every dataset of a checkpoint: the table's, then the history fields' of pairs and of walls, then the channels'.
 #[cfg(test)]
 pub(crate) fn all_datasets() -> Vec<DatasetSpec> {
     let history = |t: HistoryTable| HISTORY_FIELDS.iter().map(move |f| t.spec(f));
@@ -206,6 +230,7 @@ pub(crate) fn all_datasets() -> Vec<DatasetSpec> {
         .copied()
         .chain(history(HistoryTable::Pairs))
         .chain(history(HistoryTable::Walls))
+        .chain(CHANNELS.iter().map(channel_spec))
         .collect()
 }
 
@@ -370,6 +395,7 @@ pub(crate) const GROUPS: &[&str] = &[
     "gas",
     "gas/last_step",
     "net_force",
+    "particles/channels",
 ];
 
 /// The scalar part of a checkpoint: the root attributes other than `format` and the checksum.
@@ -475,6 +501,7 @@ impl Arrays {
 
             pair_history: HistoryArrays::of(state.contacts.pairs.iter().map(|(_, _, h)| h)),
             wall_history: HistoryArrays::of(state.contacts.walls.iter().map(|(_, _, h)| h)),
+            channels: p.channels.clone(),
         }
     }
 
@@ -530,6 +557,13 @@ impl Arrays {
                 return Err(format!("/{path} has {len} values but /gas/time_s has {gas_scalars}"));
             }
         }
+        let channel_rows = (CHANNELS[0].get)(&self.channels).len();
+        if channel_rows != 0 && channel_rows != n {
+            return Err(format!(
+                "/{} has {channel_rows} rows, expected 0 or one per particle ({n})",
+                CHANNELS[0].path
+            ));
+        }
         let tallies = self.net_force_steps.len();
         let tally_walls = self.net_force_wall_contact_n.len() / 3;
         if tallies > 1 || tally_walls != tallies * n_walls {
@@ -567,6 +601,7 @@ impl Arrays {
             torque_n_m: unflatten(&self.torque_n_m),
             liquid_m3: self.liquid_m3,
             sprayed_m3: self.sprayed_m3,
+            channels: self.channels,
         };
         let record = |active: u8, history: &HistoryArrays, k: usize| {
             let mut h = ContactHistory {

@@ -31,7 +31,7 @@ use crate::engine::SimState;
 
 /// Version of the file layout. Bump it whenever a name, type, shape or the checksum definition changes; readers
 /// reject any other version with [`CheckpointError::Version`].
-pub const CHECKPOINT_FORMAT_VERSION: u32 = 5;
+pub const CHECKPOINT_FORMAT_VERSION: u32 = 6;
 
 /// Metadata stored beside the state.
 #[derive(Debug, Clone, PartialEq)]
@@ -412,6 +412,7 @@ fn expected_shape(spec: &DatasetSpec) -> String {
         Rows::GasScalar => "0 or 1".to_string(),
         Rows::NetForce => "0 or 1".to_string(),
         Rows::NetForceWalls => "0 or walls".to_string(),
+        Rows::ParticleChannels => "0 or N".to_string(),
     };
     if spec.width == 1 {
         format!("[{rows}]")
@@ -424,9 +425,10 @@ fn expected_shape(spec: &DatasetSpec) -> String {
 mod tests {
     use super::*;
     use crate::engine::Vec3;
+    use crate::engine::channels::{CHANNELS, ParticleChannels};
     use crate::engine::contacts::{ContactStore, WallId};
     use crate::engine::models::ContactHistory;
-    use crate::engine::models::history::{CohesionHistory, NormalHistory, TangentialHistory};
+    use crate::engine::models::history::{CohesionHistory, DurationHistory, NormalHistory, TangentialHistory};
     use crate::engine::particles::{ParticleId, Particles, SpeciesId};
     use crate::engine::state::RngState;
 
@@ -450,6 +452,9 @@ mod tests {
                 shear: v(1.1e-7 * k, -2.3e-8 * k, -0.0),
                 reversal_force_n: v(0.31 * k, 1.7e-3, -4.9e-2 * k),
                 increment_direction: v(0.6, -0.8 * k / k.abs(), SUBNORMAL),
+            },
+            duration: DurationHistory {
+                duration_s: 2.5e-4 * k.abs(),
             },
             cohesion: CohesionHistory {
                 bridge_volume_m3: 1.5e-13 * k.abs(),
@@ -488,6 +493,12 @@ mod tests {
             p.sprayed_m3.push(3.0e-13 * f);
         }
         p.position_m[2].x = DISTINCTIVE;
+        p.channels = ParticleChannels::new(5, true);
+        for (k, info) in CHANNELS.iter().enumerate() {
+            for (i, x) in (info.get_mut)(&mut p.channels).iter_mut().enumerate() {
+                *x = 1.25e-3 * (k + 1) as f64 + i as f64;
+            }
+        }
         let contacts = ContactStore {
             pairs: vec![
                 (ParticleId(0), ParticleId(1), history(1.0, false)),

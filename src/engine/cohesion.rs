@@ -1,31 +1,23 @@
-//! The cohesion pass: forces between particles (and walls) at a distance, from the scenario's cohesion model,
-//! with the per-pair state the models carry from step to step.
+//! Cohesion between particles (and walls) at a distance: the run's cohesion model with everything derived from it
+//! once (ranges, contact angles, rupture shares, Young–Laplace tables), and the kernel the pair pass calls for one
+//! pair or particle–wall slot: the capillary and viscous forces of a liquid bridge, Hamaker's attraction, the square
+//! well's crossing impulse.
 //!
-//! It runs once per step after the neighbour list and the gas forces, before the contact pass, and adds its forces
-//! to the force and torque arrays that the contact pass then completes (the contact pass itself is unchanged, so a
-//! dry run pays nothing). Its state, aligned with the neighbour list's slots like the contact histories:
-//! - liquid bridges: the volume of the bridge between i and j (0: no bridge). A bridge forms when the particles
-//!   touch and takes liquid from both (seed 000 eqs 6.1–6.4); it keeps its volume until the gap passes the rupture
-//!   gap, when the volume goes back to the two particles in the shares of the parabolic bridge (6.33–6.44). The
-//!   particles' liquid and the bridges' volumes always add up to the same total (changed only by rounding);
-//! - square well: whether the pair is inside the well.
-//!
-//! The pass is serial over particles in index order and applies every event (bridge formation, rupture, well
-//! crossing) in that order, so results do not depend on the thread count.
+//! A wall is a partner like a particle: of infinite radius and mass, so the pair's effective radius is the
+//! particle's (R* = R_i), its reduced mass the particle's (μ = m_i), and the square well twice as deep (seed 001
+//! §6.2.4.2). The kernel reads the pair's cohesion slot (`models::history::CohesionHistory`): the bridge volume,
+//! which the liquid inventory (`engine::liquid`) sets when a bridge forms or breaks, and whether the pair is in the
+//! well, which it updates itself. What does not live here: the liquid (`engine::liquid`), the pass (`pair_pass`).
 
 use super::Vec3;
-use super::contacts::AlignedHistory;
 use super::models::capillary::{
-    MikamiBridge, bridge_volume_on_contact_m3, lian_rupture_gap_m, viscous_normal_force_n,
-    viscous_tangential_coefficient_n_s_per_m,
+    MikamiBridge, lian_rupture_gap_m, viscous_normal_force_n, viscous_tangential_coefficient_n_s_per_m,
 };
 use super::models::capillary_table::CapillaryTable;
 use super::models::cohesion_law::{CapillaryForce, CohesionModel, square_well_crossing};
 use super::models::history::CohesionHistory;
 use super::models::liquid_transfer::rupture_share_of_i;
-use super::neighbor::NeighborList;
-use super::particles::{Particles, SpeciesId, SpeciesTable};
-use super::simulation::SimConfig;
+use super::particles::{SpeciesId, SpeciesTable};
 
 /// A cohesion model with everything derived from it once per run.
 #[derive(Debug, Clone, PartialEq)]
@@ -37,13 +29,21 @@ pub struct Cohesion {
     pub wall_range_m: f64,
     /// Liquid bridges: the smallest gap the viscous forces see, m.
     pub min_gap_m: f64,
+    /// Square well: r_outer/r_inner (a pair is in the well while its centres are closer than this × (R_i + R_j));
+    /// infinite for the other models, which do not read it.
+    pub well_ratio: f64,
     /// Contact angle per species, rad.
     pub contact_angle_rad: Vec<f64>,
     /// Rupture shares per unordered species pair a ≤ b, row by row of the upper triangle.
     pub rupture: Vec<RuptureTable>,
-    /// Liquid bridges: the Young–Laplace force table per unordered species pair (indexed as `rupture`), or `None`
-    /// where Mikami's fit applies (equal radii and both contact angles 0, with `capillary_force: auto`).
-    pub capillary: Vec<Option<CapillaryTable>>,
+    /// Liquid bridges: the Young–Laplace force tables in use.
+    pub tables: Vec<CapillaryTable>,
+    /// Per unordered species pair (indexed as `rupture`): its table in `tables`, or `None` where Mikami's fit
+    /// applies (equal radii and both contact angles 0, with `capillary_force: auto`).
+    pub pair_tables: Vec<Option<u32>>,
+    /// Per particle species a and wall species b (index a × species + b): the sphere–plane table of a bridge to a
+    /// wall (`None` where bridges to walls are off or for wall species no wall has).
+    pub wall_tables: Vec<Option<u32>>,
     /// The model acts between particles (scenario `cohesion_off.between_particles` switches it off).
     pub between_particles: bool,
     /// Per wall: the model acts on it (empty: on every wall when `wall_range_m` > 0; `cohesion_off.walls`).
@@ -59,7 +59,15 @@ const BRIDGE_VOLUME_ALLOWANCE: f64 = 4.0;
 impl Cohesion {
     /// Derives the run's cohesion from `model`, the species and the particles' largest radius. Errors name the
     /// key under `cohesion` (or `species`) and what was expected.
-    pub fn new(model: CohesionModel, species: &SpeciesTable, max_radius_m: f64) -> Result<Cohesion, (String, String)> {
+    ///
+    /// `wall_species`: the species of the walls (bridges to a wall of one of them get a sphere–plane table where
+    /// they need one).
+    pub fn new(
+        model: CohesionModel,
+        species: &SpeciesTable,
+        wall_species: &[SpeciesId],
+        max_radius_m: f64,
+    ) -> Result<Cohesion, (String, String)> {
         let positive = |key: &str, v: f64| {
             if v.is_finite() && v > 0.0 {
                 Ok(())
@@ -74,9 +82,12 @@ impl Cohesion {
             range_m: 0.0,
             wall_range_m: 0.0,
             min_gap_m: 0.0,
+            well_ratio: f64::INFINITY,
             contact_angle_rad,
             rupture: Vec::new(),
-            capillary: Vec::new(),
+            tables: Vec::new(),
+            pair_tables: Vec::new(),
+            wall_tables: vec![None; n * n],
             between_particles: true,
             wall_on: Vec::new(),
             n_species: n,
@@ -154,10 +165,26 @@ impl Cohesion {
                         let (ta, tb) = (a.contact_angle_rad, b.contact_angle_rad);
                         // Mikami's fit only where it is settled: equal particles at θ = 0 (B2).
                         let mikami_settled = a.radius_m == b.radius_m && ta == 0.0 && tb == 0.0;
-                        cohesion.capillary.push(
-                            (!mikami_settled || b_law == CapillaryForce::YoungLaplace)
-                                .then(|| capillary_table(a.radius_m, b.radius_m, ta, tb)),
-                        );
+                        let table = (!mikami_settled || b_law == CapillaryForce::YoungLaplace).then(|| {
+                            cohesion.tables.push(capillary_table(a.radius_m, b.radius_m, ta, tb));
+                            (cohesion.tables.len() - 1) as u32
+                        });
+                        cohesion.pair_tables.push(table);
+                    }
+                }
+                // Bridges to walls: always the sphere–plane table (the wall an infinite sphere, R₂/R₁ = ∞). Mikami's
+                // equal-sphere fit read at R* = R_i is within 3 % of it at contact but 67–78 % below it near rupture
+                // even at θ = 0 (`young_laplace.rs`), so it is settled for no wall.
+                if b.walls {
+                    let mut wall_species = wall_species.to_vec();
+                    wall_species.sort_by_key(|w| w.index());
+                    wall_species.dedup();
+                    for (ka, a) in species.species.iter().enumerate() {
+                        for &w in &wall_species {
+                            let (ta, tw) = (a.contact_angle_rad, species.species[w.index()].contact_angle_rad);
+                            cohesion.tables.push(capillary_table(a.radius_m, f64::INFINITY, ta, tw));
+                            cohesion.wall_tables[ka * n + w.index()] = Some((cohesion.tables.len() - 1) as u32);
+                        }
                     }
                 }
             }
@@ -187,6 +214,7 @@ impl Cohesion {
                 }
                 // The well reaches (ratio − 1)(R_i + R_j) beyond contact; a little more so that a pair just outside
                 // is still seen leaving.
+                cohesion.well_ratio = w.outer_to_inner_radius_ratio;
                 let width = (w.outer_to_inner_radius_ratio - 1.0) * 2.0 * max_radius_m;
                 cohesion.range_m = 2.0 * width;
                 cohesion.wall_range_m = if w.walls { width } else { 0.0 };
@@ -196,14 +224,14 @@ impl Cohesion {
     }
 
     /// The index of the unordered species pair {a, b} in the per-pair tables.
-    fn pair_index(&self, a: SpeciesId, b: SpeciesId) -> usize {
+    pub fn pair_index(&self, a: SpeciesId, b: SpeciesId) -> usize {
         let (lo, hi) = (a.index().min(b.index()), a.index().max(b.index()));
         // Row lo of the upper triangle starts after the rows above it: lo·n − lo(lo−1)/2.
         lo * self.n_species - lo * lo.saturating_sub(1) / 2 + (hi - lo)
     }
 
     /// The share particle i (species `a`) keeps of a breaking bridge of `volume_m3` with a particle of species `b`.
-    fn rupture_share_of_i(&self, a: SpeciesId, b: SpeciesId, volume_m3: f64) -> f64 {
+    pub fn rupture_share_of_i(&self, a: SpeciesId, b: SpeciesId, volume_m3: f64) -> f64 {
         let table = &self.rupture[self.pair_index(a, b)];
         let share = table.share_of_i(volume_m3);
         if a.index() <= b.index() { share } else { 1.0 - share }
@@ -286,32 +314,178 @@ impl RuptureTable {
     }
 }
 
-/// Workspace of the cohesion pass aligned with the slots of a [`NeighborList`]: per pair slot, the Mikami constants
-/// and rupture gap of its bridge for the volume they were computed for (rebuilt from the state, never
-/// checkpointed). The per-pair state itself is the cohesion slot of the contact history (`models::history`).
-#[derive(Debug, Clone, Default)]
-pub struct BridgeCache {
-    bridges: Vec<BridgeConstants>,
+/// What the cohesion model's events have been: bridges formed and broken (`engine::liquid`), square-well crossings
+/// (the pair pass). For diagnostics.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct CohesionEvents {
+    pub bridges_formed: u64,
+    pub bridges_ruptured: u64,
+    pub well_crossings: u64,
 }
 
-/// What a bridge's force and rupture need that stays fixed while its volume does.
+/// What a bridge's force and rupture need that stays fixed while its volume does: computed by the liquid inventory
+/// when a bridge forms or changes (`engine::liquid`), read by the kernel.
 #[derive(Debug, Clone, Copy)]
-struct BridgeConstants {
+pub struct BridgeConstants {
     /// The volume these were computed for (NaN: none).
-    volume_m3: f64,
-    mikami: MikamiBridge,
-    /// The pair's Young–Laplace table (index into `Cohesion::capillary`), used instead of `mikami`.
-    table: Option<u32>,
-    rupture_gap_m: f64,
+    pub volume_m3: f64,
+    pub mikami: MikamiBridge,
+    /// The pair's Young–Laplace table (index into `Cohesion::tables`), used instead of `mikami`.
+    pub table: Option<u32>,
+    pub rupture_gap_m: f64,
 }
 
 impl BridgeConstants {
-    const NONE: BridgeConstants = BridgeConstants {
+    pub const NONE: BridgeConstants = BridgeConstants {
         volume_m3: f64::NAN,
         mikami: MikamiBridge::ZERO,
         table: None,
         rupture_gap_m: 0.0,
     };
+}
+
+/// One cohesive interaction as the kernel sees it from particle i: a particle pair, or a particle and a wall (an
+/// infinite radius and mass). The pair pass forms it with the formulas below for either partner.
+#[derive(Debug, Clone, Copy)]
+pub struct Bond {
+    /// Unit normal from the partner to i.
+    pub normal: Vec3,
+    /// Surface gap (negative in overlap), m.
+    pub gap_m: f64,
+    /// Centre distance (to the wall's surface for a wall), m, and the distance below which the pair is inside the
+    /// square well: r_outer/r_inner × (R_i + R_j), or × R_i for a wall.
+    pub centre_distance_m: f64,
+    pub well_distance_m: f64,
+    /// R* = R_i R_j/(R_i + R_j), or R_i for a wall.
+    pub effective_radius_m: f64,
+    /// μ = m_i m_j/(m_i + m_j), or m_i for a wall.
+    pub effective_mass_kg: f64,
+    /// −(v_i − v_partner)·n: positive while the pair approaches, m/s.
+    pub approach_m_per_s: f64,
+    /// Velocity of i's surface point minus the partner's, m/s (for the viscous tangential force).
+    pub contact_velocity: Vec3,
+    /// The square well's depth relative to a particle pair's: 2 for a wall (seed 001 §6.2.4.2).
+    pub depth_factor: f64,
+}
+
+/// What the kernel exerts on i: the normal part along `Bond::normal` (positive pushes i away from the partner) and
+/// the tangential part (its torque is −R n × F_t on each side).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct BondForce {
+    pub normal_n: f64,
+    pub tangential_n: Vec3,
+    /// The pair crossed the square well's edge this step.
+    pub crossed_well: bool,
+}
+
+impl BondForce {
+    pub const NONE: BondForce = BondForce {
+        normal_n: 0.0,
+        tangential_n: Vec3::new(0.0, 0.0, 0.0),
+        crossed_well: false,
+    };
+}
+
+impl Cohesion {
+    /// The cohesion force of one bond at the current positions (velocities at the half step), updating the slot's
+    /// square-well state. `bridge`: the constants of the slot's liquid bridge (for its current volume). `dt_s` turns
+    /// the square well's crossing impulse into a force acting for one step (the two half kicks of velocity Verlet
+    /// deliver exactly F dt).
+    #[inline]
+    pub fn force(&self, bond: &Bond, state: &mut CohesionHistory, bridge: &BridgeConstants, dt_s: f64) -> BondForce {
+        match self.model {
+            CohesionModel::LiquidBridge(b) => {
+                if state.bridge_volume_m3 <= 0.0 {
+                    return BondForce::NONE;
+                }
+                // Seed 000 eqs 2.16-2.17 (Mikami) or 6.5-6.28 (the Young–Laplace table); 2.19-2.20 (viscous).
+                let capillary = match bridge.table {
+                    Some(t) => {
+                        self.tables[t as usize].force_n(state.bridge_volume_m3, bond.gap_m, b.surface_tension_n_per_m)
+                    }
+                    None => bridge.mikami.force_n(bond.gap_m),
+                };
+                let mut normal_n = -capillary;
+                let mut tangential_n = Vec3::zeros();
+                if b.viscosity_pa_s > 0.0 {
+                    let r = bond.effective_radius_m;
+                    normal_n +=
+                        viscous_normal_force_n(r, b.viscosity_pa_s, bond.approach_m_per_s, bond.gap_m, self.min_gap_m);
+                    let coefficient =
+                        viscous_tangential_coefficient_n_s_per_m(r, b.viscosity_pa_s, bond.gap_m, self.min_gap_m);
+                    let v = bond.contact_velocity;
+                    let tangential_velocity = v - bond.normal * v.dot(&bond.normal);
+                    tangential_n = -tangential_velocity * coefficient;
+                }
+                BondForce {
+                    normal_n,
+                    tangential_n,
+                    crossed_well: false,
+                }
+            }
+            CohesionModel::Hamaker(h) => {
+                if bond.gap_m < h.outer_cutoff_m {
+                    BondForce {
+                        normal_n: -h.law().pair_force_n(bond.effective_radius_m, bond.gap_m),
+                        ..BondForce::NONE
+                    }
+                } else {
+                    BondForce::NONE
+                }
+            }
+            CohesionModel::SquareWell(w) => {
+                let inside = bond.centre_distance_m < bond.well_distance_m;
+                let approach = bond.approach_m_per_s;
+                let entering = !state.in_well && inside;
+                let leaving = state.in_well && !inside && approach < 0.0;
+                if !((entering || leaving) && dt_s > 0.0) {
+                    return BondForce::NONE;
+                }
+                let mu = bond.effective_mass_kg;
+                let speed = if entering { approach.abs() } else { approach };
+                let (mut after, now_inside) = square_well_crossing(bond.depth_factor * w.depth_j, mu, speed, entering);
+                if entering && approach < 0.0 {
+                    after = -after;
+                }
+                state.in_well = now_inside;
+                // Impulse P n on i changes the approach speed by −P/μ.
+                BondForce {
+                    normal_n: mu * (approach - after) / dt_s,
+                    tangential_n: Vec3::zeros(),
+                    crossed_well: true,
+                }
+            }
+        }
+    }
+
+    /// The constants of a bridge of `volume_m3` between particle species `a` and `b` (effective radius `r_star_m`).
+    pub fn pair_bridge(&self, a: SpeciesId, b: SpeciesId, r_star_m: f64, volume_m3: f64) -> BridgeConstants {
+        let CohesionModel::LiquidBridge(bridge) = self.model else {
+            return BridgeConstants::NONE;
+        };
+        let (ti, tj) = (self.contact_angle_rad[a.index()], self.contact_angle_rad[b.index()]);
+        BridgeConstants {
+            volume_m3,
+            mikami: MikamiBridge::new(r_star_m, volume_m3, 0.5 * (ti + tj), bridge.surface_tension_n_per_m),
+            table: self.pair_tables[self.pair_index(a, b)],
+            rupture_gap_m: lian_rupture_gap_m(volume_m3, ti, tj).min(self.range_m),
+        }
+    }
+
+    /// The constants of a bridge of `volume_m3` between a particle of species `a` and radius `radius_m` and a wall of
+    /// species `wall` (a plane: R* = R_i).
+    pub fn wall_bridge(&self, a: SpeciesId, wall: SpeciesId, radius_m: f64, volume_m3: f64) -> BridgeConstants {
+        let CohesionModel::LiquidBridge(bridge) = self.model else {
+            return BridgeConstants::NONE;
+        };
+        let (ti, tw) = (self.contact_angle_rad[a.index()], self.contact_angle_rad[wall.index()]);
+        BridgeConstants {
+            volume_m3,
+            mikami: MikamiBridge::new(radius_m, volume_m3, 0.5 * (ti + tw), bridge.surface_tension_n_per_m),
+            table: self.wall_tables[a.index() * self.n_species + wall.index()],
+            rupture_gap_m: lian_rupture_gap_m(volume_m3, ti, tw).min(self.wall_range_m),
+        }
+    }
 }
 
 /// The Young–Laplace force table of one species pair, from the disk cache when it holds it (built and cached
@@ -325,275 +499,6 @@ fn capillary_table(radius_1_m: f64, radius_2_m: f64, angle_1_rad: f64, angle_2_r
         Provenance::BuiltOnly(why) => tracing::info!("Young–Laplace table built, not cached: {why}"),
     }
     table
-}
-
-/// Liquid on the particles and in the bridges, m³.
-pub fn total_liquid_m3(liquid_m3: &[f64], history: &AlignedHistory) -> f64 {
-    liquid_m3.iter().sum::<f64>()
-        + history.pair.cohesion.bridge_volume_m3.iter().sum::<f64>()
-        + history.wall.cohesion.bridge_volume_m3.iter().sum::<f64>()
-}
-
-/// What a pass did, for diagnostics.
-#[derive(Debug, Clone, Copy, Default, PartialEq)]
-pub struct CohesionPass {
-    pub bridges_formed: u64,
-    pub bridges_ruptured: u64,
-    pub well_crossings: u64,
-}
-
-/// Adds the cohesion forces at the current positions (velocities at the half step) to `p.force_n` and
-/// `p.torque_n_m`, updating the cohesion slot of `history` and the particles' liquid. `dt_s` turns the square well's crossing impulses
-/// into forces acting for one step (the two half kicks of velocity Verlet deliver exactly F dt). With `per_wall_n`,
-/// each wall's cohesion force on all particles is added there too (index = wall, particles ascending).
-#[allow(clippy::too_many_arguments)]
-pub fn apply_cohesion(
-    cohesion: &Cohesion,
-    config: &SimConfig,
-    p: &mut Particles,
-    list: &NeighborList,
-    history: &mut AlignedHistory,
-    cache: &mut BridgeCache,
-    wall_angle_rad: &[f64],
-    dt_s: f64,
-    mut per_wall_n: Option<&mut [Vec3]>,
-) -> CohesionPass {
-    let n = p.len();
-    let mut pass = CohesionPass::default();
-    if cache.bridges.len() != list.partner.len() {
-        cache.bridges.clear();
-        cache.bridges.resize(list.partner.len(), BridgeConstants::NONE);
-    }
-    let pair_state = &mut history.pair.cohesion;
-    let wall_state = &mut history.wall.cohesion;
-    for i in 0..n {
-        let (xi, vi, wi, ri, mi, si) = (
-            p.position_m[i],
-            p.velocity_m_per_s[i],
-            p.angular_velocity_rad_per_s[i],
-            p.radius_m[i],
-            p.mass_kg[i],
-            p.species[i],
-        );
-        let pairs = if cohesion.between_particles {
-            list.pairs_of(i)
-        } else {
-            0..0
-        };
-        for k in pairs {
-            let j = list.partner[k] as usize;
-            let d = config.domain.separation(&xi, &p.position_m[j]);
-            let (rj, mj, sj) = (p.radius_m[j], p.mass_kg[j], p.species[j]);
-            let reach = ri + rj;
-            let dist2 = d.norm_squared();
-            let mut slot = CohesionHistory {
-                bridge_volume_m3: pair_state.bridge_volume_m3[k],
-                in_well: pair_state.in_well[k],
-            };
-            // Out of range and carrying nothing: the common case.
-            let range = reach + cohesion.range_m;
-            if dist2 >= range * range && slot.is_empty() {
-                continue;
-            }
-            let dist = dist2.sqrt();
-            let normal = d / dist;
-            let gap = dist - reach;
-            let u = vi - p.velocity_m_per_s[j];
-            let approach = -u.dot(&normal);
-            let r_star = ri * rj / reach;
-            let mut force_on_i = Vec3::zeros();
-            let mut tangential = Vec3::zeros();
-            match cohesion.model {
-                CohesionModel::LiquidBridge(b) => {
-                    let (ti, tj) = (
-                        cohesion.contact_angle_rad[si.index()],
-                        cohesion.contact_angle_rad[sj.index()],
-                    );
-                    if slot.bridge_volume_m3 == 0.0 && gap < 0.0 {
-                        let (from_i, from_j) = bridge_volume_on_contact_m3(p.liquid_m3[i], ri, p.liquid_m3[j], rj);
-                        if from_i + from_j > 0.0 {
-                            p.liquid_m3[i] -= from_i;
-                            p.liquid_m3[j] -= from_j;
-                            slot.bridge_volume_m3 = from_i + from_j;
-                            pass.bridges_formed += 1;
-                        }
-                    }
-                    let constants = &mut cache.bridges[k];
-                    if slot.bridge_volume_m3 > 0.0 && constants.volume_m3 != slot.bridge_volume_m3 {
-                        let pair = cohesion.pair_index(si, sj);
-                        *constants = BridgeConstants {
-                            volume_m3: slot.bridge_volume_m3,
-                            mikami: MikamiBridge::new(
-                                r_star,
-                                slot.bridge_volume_m3,
-                                0.5 * (ti + tj),
-                                b.surface_tension_n_per_m,
-                            ),
-                            table: cohesion.capillary[pair].is_some().then_some(pair as u32),
-                            rupture_gap_m: lian_rupture_gap_m(slot.bridge_volume_m3, ti, tj).min(cohesion.range_m),
-                        };
-                    }
-                    if slot.bridge_volume_m3 > 0.0 && gap > constants.rupture_gap_m {
-                        let volume = slot.bridge_volume_m3;
-                        let kept_by_i = cohesion.rupture_share_of_i(si, sj, volume) * volume;
-                        p.liquid_m3[i] += kept_by_i;
-                        p.liquid_m3[j] += volume - kept_by_i;
-                        slot.bridge_volume_m3 = 0.0;
-                        pass.bridges_ruptured += 1;
-                    }
-                    if slot.bridge_volume_m3 > 0.0 {
-                        let capillary = match constants.table {
-                            Some(t) => cohesion.capillary[t as usize].as_ref().map_or(0.0, |table| {
-                                table.force_n(slot.bridge_volume_m3, gap, b.surface_tension_n_per_m)
-                            }),
-                            None => constants.mikami.force_n(gap),
-                        };
-                        let mut normal_force = -capillary;
-                        if b.viscosity_pa_s > 0.0 {
-                            normal_force +=
-                                viscous_normal_force_n(r_star, b.viscosity_pa_s, approach, gap, cohesion.min_gap_m);
-                            let coefficient = viscous_tangential_coefficient_n_s_per_m(
-                                r_star,
-                                b.viscosity_pa_s,
-                                gap,
-                                cohesion.min_gap_m,
-                            );
-                            let contact_velocity = u - (wi * ri + p.angular_velocity_rad_per_s[j] * rj).cross(&normal);
-                            let ut = contact_velocity - normal * contact_velocity.dot(&normal);
-                            tangential = -ut * coefficient;
-                        }
-                        force_on_i = normal * normal_force + tangential;
-                    }
-                }
-                CohesionModel::Hamaker(h) => {
-                    if gap < h.outer_cutoff_m {
-                        force_on_i = -normal * h.law().pair_force_n(r_star, gap);
-                    }
-                }
-                CohesionModel::SquareWell(w) => {
-                    let inside = dist < w.outer_to_inner_radius_ratio * reach;
-                    let entering = !slot.in_well && inside;
-                    let leaving = slot.in_well && !inside && approach < 0.0;
-                    if (entering || leaving) && dt_s > 0.0 {
-                        let mu = mi * mj / (mi + mj);
-                        let speed = if entering { approach.abs() } else { approach };
-                        let (mut after, now_inside) = square_well_crossing(w.depth_j, mu, speed, entering);
-                        if entering && approach < 0.0 {
-                            after = -after;
-                        }
-                        slot.in_well = now_inside;
-                        // Impulse P n on i changes the approach speed by −P/μ.
-                        force_on_i = normal * (mu * (approach - after) / dt_s);
-                        pass.well_crossings += 1;
-                    }
-                }
-            }
-            pair_state.bridge_volume_m3[k] = slot.bridge_volume_m3;
-            pair_state.in_well[k] = slot.in_well;
-            if force_on_i != Vec3::zeros() {
-                p.force_n[i] += force_on_i;
-                p.force_n[j] -= force_on_i;
-                if tangential != Vec3::zeros() {
-                    let nxft = normal.cross(&tangential);
-                    p.torque_n_m[i] -= nxft * ri;
-                    p.torque_n_m[j] -= nxft * rj;
-                }
-            }
-        }
-        if cohesion.wall_range_m > 0.0 {
-            for k in list.walls_of(i) {
-                let w = list.wall_partner[k] as usize;
-                if !cohesion.wall_on.get(w).copied().unwrap_or(true) {
-                    continue;
-                }
-                let prox = config.walls[w].proximity(&xi, wall_angle_rad[w]);
-                let gap = prox.gap_m - ri;
-                let mut slot = CohesionHistory {
-                    bridge_volume_m3: wall_state.bridge_volume_m3[k],
-                    in_well: wall_state.in_well[k],
-                };
-                if gap >= cohesion.wall_range_m && slot.is_empty() {
-                    continue;
-                }
-                let approach = -(vi - prox.wall_velocity).dot(&prox.normal);
-                let mut tangential = Vec3::zeros();
-                let force = match cohesion.model {
-                    CohesionModel::LiquidBridge(b) => {
-                        let (ti, tw) = (
-                            cohesion.contact_angle_rad[si.index()],
-                            cohesion.contact_angle_rad[config.walls[w].species.index()],
-                        );
-                        if slot.bridge_volume_m3 == 0.0 && gap < 0.0 && p.liquid_m3[i] > 0.0 {
-                            // Eq 6.1 with R_j → ∞: the cap facing a plane is half the particle.
-                            let taken = 0.5 * p.liquid_m3[i];
-                            p.liquid_m3[i] -= taken;
-                            slot.bridge_volume_m3 = taken;
-                            pass.bridges_formed += 1;
-                        }
-                        let volume = slot.bridge_volume_m3;
-                        if volume > 0.0 && gap > lian_rupture_gap_m(volume, ti, tw).min(cohesion.wall_range_m) {
-                            p.liquid_m3[i] += volume;
-                            slot.bridge_volume_m3 = 0.0;
-                            pass.bridges_ruptured += 1;
-                        }
-                        if slot.bridge_volume_m3 > 0.0 {
-                            let mut f =
-                                -MikamiBridge::new(ri, volume, 0.5 * (ti + tw), b.surface_tension_n_per_m).force_n(gap);
-                            if b.viscosity_pa_s > 0.0 {
-                                f += viscous_normal_force_n(ri, b.viscosity_pa_s, approach, gap, cohesion.min_gap_m);
-                                let coefficient = viscous_tangential_coefficient_n_s_per_m(
-                                    ri,
-                                    b.viscosity_pa_s,
-                                    gap,
-                                    cohesion.min_gap_m,
-                                );
-                                let contact_velocity = vi - prox.wall_velocity - (wi * ri).cross(&prox.normal);
-                                let ut = contact_velocity - prox.normal * contact_velocity.dot(&prox.normal);
-                                tangential = -ut * coefficient;
-                                p.force_n[i] += tangential;
-                                p.torque_n_m[i] -= prox.normal.cross(&tangential) * ri;
-                            }
-                            f
-                        } else {
-                            0.0
-                        }
-                    }
-                    CohesionModel::Hamaker(h) => {
-                        if gap < h.outer_cutoff_m {
-                            -h.law().wall_force_n(ri, gap)
-                        } else {
-                            0.0
-                        }
-                    }
-                    CohesionModel::SquareWell(sw) => {
-                        let inside = prox.gap_m < sw.outer_to_inner_radius_ratio * ri;
-                        let entering = !slot.in_well && inside;
-                        let leaving = slot.in_well && !inside && approach < 0.0;
-                        if (entering || leaving) && dt_s > 0.0 {
-                            // The wall: infinite mass (μ = m_i) and twice the depth (seed 001 §6.2.4.2).
-                            let speed = if entering { approach.abs() } else { approach };
-                            let (mut after, now_inside) = square_well_crossing(2.0 * sw.depth_j, mi, speed, entering);
-                            if entering && approach < 0.0 {
-                                after = -after;
-                            }
-                            slot.in_well = now_inside;
-                            pass.well_crossings += 1;
-                            mi * (approach - after) / dt_s
-                        } else {
-                            0.0
-                        }
-                    }
-                };
-                wall_state.bridge_volume_m3[k] = slot.bridge_volume_m3;
-                wall_state.in_well[k] = slot.in_well;
-                p.force_n[i] += prox.normal * force;
-                if let Some(out) = per_wall_n.as_deref_mut() {
-                    out[w] += tangential + prox.normal * force;
-                }
-            }
-        }
-    }
-    pass
 }
 
 #[cfg(test)]
@@ -639,7 +544,7 @@ mod tests {
             species: vec![bead("left"), bead("right")],
         };
         let model = CohesionModel::LiquidBridge(serde_norway::from_str("surface_tension_n_per_m: 0.02").unwrap());
-        let cohesion = Cohesion::new(model, &species, 1.35e-3).expect("valid cohesion");
+        let cohesion = Cohesion::new(model, &species, &[], 1.35e-3).expect("valid cohesion");
         let (left, right) = (SpeciesId(0), SpeciesId(1));
         for v_hat in [1e-5, 1e-3, 0.02] {
             let volume = v_hat * 1.35e-3f64.powi(3);

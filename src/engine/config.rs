@@ -36,14 +36,18 @@ pub struct SimConfig {
     pub max_overlap_fraction: f64,
     /// Forces at a distance (liquid bridges, van der Waals, square well); `None`: dry, cohesionless particles.
     pub cohesion: Option<Cohesion>,
+    /// Record each contact's duration and the particles' contact statistics (`engine::channels`;
+    /// `output.contact_statistics`).
+    pub contact_statistics: bool,
 }
 
 impl SimConfig {
-    /// The history columns the run's models use: the contact law's, and the cohesion slot's when there is a
-    /// cohesion model.
+    /// The history columns the run's models use: the contact law's, the cohesion slot's when there is a cohesion
+    /// model, and the duration slot's when the run records contact statistics.
     pub fn history_layout(&self) -> HistoryLayout {
         HistoryLayout {
             cohesion: self.cohesion.is_some(),
+            contact_duration: self.contact_statistics,
             ..self.contact_law.history_layout()
         }
     }

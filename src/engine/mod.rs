@@ -1,7 +1,8 @@
-//! The simulation engine: soft-sphere DEM (this issue), with the gas phase, cohesion, heat and mass transfer to
-//! join. It knows nothing about campaigns; `Simulation` is driven by `crate::run` (the `simulate` command) and,
-//! later, by workers.
+//! The simulation engine: soft-sphere DEM with cohesion and liquid, coupled to the gas phase. It knows nothing about
+//! campaigns; a [`Simulation`] is driven by `crate::simulate` (the `simulate` command and the workers).
+//! `docs/ARCHITECTURE.md` maps its files and one time step through them.
 
+pub mod channels;
 pub mod cohesion;
 pub mod config;
 pub mod contacts;
@@ -9,6 +10,7 @@ pub mod error;
 pub mod gas;
 pub mod geometry;
 pub mod integrate;
+pub mod liquid;
 pub mod models;
 pub mod neighbor;
 pub mod net_force;

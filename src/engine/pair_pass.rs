@@ -1,4 +1,10 @@
-//! Contact forces and torques on every particle, accumulated in one fixed order whatever the thread count.
+//! The pair pass: every force between two particles or a particle and a wall — the contact law and, in a cohesive
+//! run, the cohesion model's forces at a distance — on every particle, accumulated in one fixed order whatever the
+//! thread count.
+//!
+//! A wall is a partner like a particle, of infinite radius and mass with its own motion: each slot of the neighbour
+//! list (pair or wall) runs the same kernels, the contact law's (`models::contact_law`) while the pair overlaps and
+//! the cohesion model's (`engine::cohesion`) while it is in range or carries a state.
 //!
 //! The order for particle p is: first its contacts as the *second* particle of a pair (ascending first particle),
 //! then as the first particle (ascending partner), then its walls (ascending wall index). On one thread the pair loop
@@ -16,10 +22,13 @@ use std::sync::atomic::Ordering;
 use std::time::Instant;
 
 use super::Vec3;
+use super::channels::{ChannelsMut, ParticleChannels, ScalarFlows};
+use super::cohesion::{Bond, BridgeConstants, Cohesion};
 use super::contacts::{AlignedHistory, ColumnsMut, split_at_ends};
 use super::geometry::Wall;
 use super::integrate::{InverseInertia, half_kick_one};
-use super::models::history::ContactLayout;
+use super::liquid::BridgeCache;
+use super::models::history::{CohesionHistory, HistoryLayout, StaticLayout};
 use super::models::{ContactKinematics, ContactLaw, PairTable};
 use super::neighbor::NeighborList;
 use super::particles::{ParticleId, Particles, SpeciesId};
@@ -27,20 +36,52 @@ use super::range_plan::RangePlan;
 use super::simulation::SimConfig;
 use super::team::Team;
 
+/// What the pass knows at compile time: the contact law's history columns (Walton-Braun's, Thornton's) and whether
+/// it is the wide pass. A dry run without channels compiles to the contact loop alone; the contact history loads and
+/// stores only the columns its law uses.
+pub trait PassKind: StaticLayout {
+    /// The wide pass: the cohesion model's forces and the scalar channels, each where the run has them (checked
+    /// once per slot at run time; the narrow pass has neither in its code).
+    const WIDE: bool;
+}
+
+/// The pass kinds: `WB` Walton-Braun history, `TH` Thornton history, `WIDE` cohesion forces and channels.
+pub struct Pass<const WB: bool, const TH: bool, const WIDE: bool>;
+
+impl<const WB: bool, const TH: bool, const WIDE: bool> StaticLayout for Pass<WB, TH, WIDE> {
+    const LAYOUT: HistoryLayout = HistoryLayout {
+        tangential: true,
+        walton_braun: WB,
+        thornton: TH,
+        // The cohesion and duration slots are read and written field by field where the run has them, never
+        // loaded whole.
+        cohesion: false,
+        contact_duration: false,
+    };
+}
+
+impl<const WB: bool, const TH: bool, const WIDE: bool> PassKind for Pass<WB, TH, WIDE> {
+    const WIDE: bool = WIDE;
+}
+
 /// Per-slot results of cross-range pairs (multi-threaded path only).
 #[derive(Debug, Default, Clone)]
 pub struct PairBuffers {
     force_on_i: Vec<Vec3>,
     torque_on_i: Vec<Vec3>,
     torque_on_j: Vec<Vec3>,
-    touching: Vec<bool>,
+    /// The channels' flows into i (empty when the run records no channels).
+    scalars_on_i: Vec<ScalarFlows>,
+    /// The pair exerted a force (it touched, or a cohesion force acted) or gave the channels something.
+    acted: Vec<bool>,
 }
 
 impl PairBuffers {
     pub fn heap_bytes(&self) -> usize {
         (self.force_on_i.capacity() + self.torque_on_i.capacity() + self.torque_on_j.capacity())
             * std::mem::size_of::<Vec3>()
-            + self.touching.capacity()
+            + self.scalars_on_i.capacity() * std::mem::size_of::<ScalarFlows>()
+            + self.acted.capacity()
     }
 }
 
@@ -211,14 +252,33 @@ struct Context<'a> {
     reference: &'a [Vec3],
     /// The force and torque arrays are all zero on entry (the previous pass fused the next drift).
     accumulators_zeroed: bool,
+    /// The cohesion model, in a run that has one.
+    cohesion: Option<&'a Cohesion>,
+    /// The constants of the standing liquid bridges, per slot of the whole list.
+    bridges: &'a BridgeCache,
+    /// The run records the scalar channels (`engine::channels`) and the contacts' durations.
+    channels: bool,
 }
 
-/// Result of one particle–particle contact: force on i, torques on i and j.
+/// Result of one particle–particle slot: force on i, torques on i and j, and the channels' flows into i.
 #[derive(Clone, Copy)]
 struct PairResult {
     force: Vec3,
     torque_i: Vec3,
     torque_j: Vec3,
+    scalars: ScalarFlows,
+}
+
+impl PairResult {
+    /// No force, only channel flows.
+    fn flows_only(scalars: ScalarFlows) -> PairResult {
+        PairResult {
+            force: Vec3::zeros(),
+            torque_i: Vec3::zeros(),
+            torque_j: Vec3::zeros(),
+            scalars,
+        }
+    }
 }
 
 /// What the pair loop of particle i reads of i, loaded once per particle rather than once per candidate.
@@ -245,6 +305,9 @@ impl<'a> Context<'a> {
         kick: Option<HalfKick>,
         reference: &'a [Vec3],
         accumulators_zeroed: bool,
+        cohesion: Option<&'a Cohesion>,
+        bridges: &'a BridgeCache,
+        channels: bool,
     ) -> Self {
         Context {
             config,
@@ -260,6 +323,40 @@ impl<'a> Context<'a> {
             kick,
             reference,
             accumulators_zeroed,
+            cohesion,
+            bridges,
+            channels,
+        }
+    }
+
+    /// Where the run records channels and slot `k` (touching until now) separates: the contact's duration, taken
+    /// out of its slot, as the flows of an ended contact (`wall`: to a wall). `None` otherwise.
+    #[inline(always)]
+    fn contact_ended<P: PassKind>(&self, hist: &mut ColumnsMut, k: usize, wall: bool) -> Option<ScalarFlows> {
+        if !(P::WIDE && self.channels && hist.touching[k]) {
+            return None;
+        }
+        let duration_s = std::mem::replace(&mut hist.duration.duration_s[k], 0.0);
+        Some(if wall {
+            ScalarFlows {
+                wall_contacts_ended: 1.0,
+                wall_contact_time_ended_s: duration_s,
+                ..ScalarFlows::ZERO
+            }
+        } else {
+            ScalarFlows {
+                contacts_ended: 1.0,
+                contact_time_ended_s: duration_s,
+                ..ScalarFlows::ZERO
+            }
+        })
+    }
+
+    /// Where the run records channels: slot `k` touches for one more step.
+    #[inline(always)]
+    fn contact_lasts<P: PassKind>(&self, hist: &mut ColumnsMut, k: usize) {
+        if P::WIDE && self.channels {
+            hist.duration.duration_s[k] += self.dt_s;
         }
     }
 
@@ -275,11 +372,12 @@ impl<'a> Context<'a> {
         }
     }
 
-    /// Evaluates the pair (i, j) in local history slot `k` if it overlaps; otherwise releases the slot. `bi` is
-    /// [`Context::body`] of i.
+    /// Evaluates the pair (i, j) in local history slot `k` (slot `slot` of the whole list): the contact law if it
+    /// overlaps (otherwise the slot's contact history is released), and the cohesion model if one acts. `bi` is
+    /// [`Context::body`] of i. `None`: no force.
     #[allow(clippy::too_many_arguments)]
     #[inline(always)]
-    fn pair<const WB: bool, const TH: bool>(
+    fn pair<P: PassKind>(
         &self,
         i: usize,
         bi: &Body,
@@ -287,15 +385,38 @@ impl<'a> Context<'a> {
         vel: &impl Motion,
         hist: &mut ColumnsMut,
         k: usize,
+        slot: usize,
         worst: &mut WorstOverlap,
+        crossings: &mut u64,
     ) -> Option<PairResult> {
         let d = self.config.domain.separation(&bi.x, &vel.x(j));
         let dist2 = d.norm_squared();
         let (ri, rj) = (bi.radius_m, self.radius_m[j]);
         let reach = ri + rj;
+        let cohesion = if P::WIDE {
+            self.cohesion.filter(|c| c.between_particles)
+        } else {
+            None
+        };
         if dist2 >= reach * reach {
-            hist.release_as::<ContactLayout<WB, TH>>(k);
-            return None;
+            let ended = self.contact_ended::<P>(hist, k, false);
+            hist.release_as::<P>(k);
+            // Apart: the cohesion model alone, while in range or carrying a bridge or well.
+            let bond = cohesion.and_then(|c| {
+                let range = reach + c.range_m;
+                if dist2 >= range * range && cohesion_state(hist, k).is_empty() {
+                    return None;
+                }
+                Some(self.pair_bond(c, bi, j, vel, d, dist2, reach, hist, k, slot, crossings))
+            });
+            return match (bond, ended) {
+                (Some(bond), ended) => Some(PairResult {
+                    scalars: ended.unwrap_or(ScalarFlows::ZERO),
+                    ..bond
+                }),
+                (None, Some(ended)) => Some(PairResult::flows_only(ended)),
+                (None, None) => None,
+            };
         }
         let dist = dist2.sqrt();
         let inv_dist = 1.0 / dist;
@@ -320,22 +441,85 @@ impl<'a> Context<'a> {
             relative_angular_velocity: wi - wj,
         };
         let mat = self.table.get(bi.species, self.species[j]);
-        let mut h = hist.load_as::<ContactLayout<WB, TH>>(k);
+        let mut h = hist.load_as::<P>(k);
         let out = self.law.evaluate(mat, &kin, self.dt_s, &mut h);
-        hist.save_as::<ContactLayout<WB, TH>>(k, &h);
+        hist.save_as::<P>(k, &h);
+        self.contact_lasts::<P>(hist, k);
         let nxft = n.cross(&out.tangential_force);
-        Some(PairResult {
+        let contact = PairResult {
             force: out.force,
             torque_i: -(nxft * ri) + out.rolling_torque,
             torque_j: -(nxft * rj) - out.rolling_torque,
-        })
+            scalars: ScalarFlows::ZERO,
+        };
+        match cohesion {
+            None => Some(contact),
+            Some(c) => {
+                let bond = self.pair_bond(c, bi, j, vel, d, dist2, reach, hist, k, slot, crossings);
+                Some(PairResult {
+                    force: contact.force + bond.force,
+                    torque_i: contact.torque_i + bond.torque_i,
+                    torque_j: contact.torque_j + bond.torque_j,
+                    scalars: ScalarFlows::ZERO,
+                })
+            }
+        }
     }
 
-    /// Adds the wall contacts of particle i (velocity `vi`, angular velocity `wi`) to (f, t), in ascending wall
-    /// order; `hist` holds exactly i's wall slots.
+    /// The cohesion force of the pair (i, j) in local slot `k`, with the pair's geometry formed as seed 000 and
+    /// seed 001 write it (n = d/|d|, R* = R_i R_j/(R_i + R_j), μ = m_i m_j/(m_i + m_j)).
+    #[allow(clippy::too_many_arguments)]
+    #[inline(never)]
+    fn pair_bond(
+        &self,
+        c: &Cohesion,
+        bi: &Body,
+        j: usize,
+        vel: &impl Motion,
+        d: Vec3,
+        dist2: f64,
+        reach: f64,
+        hist: &mut ColumnsMut,
+        k: usize,
+        slot: usize,
+        crossings: &mut u64,
+    ) -> PairResult {
+        let (ri, rj) = (bi.radius_m, self.radius_m[j]);
+        let (mi, mj) = (bi.mass_kg, self.mass_kg[j]);
+        let dist = dist2.sqrt();
+        let normal = d / dist;
+        let u = bi.v - vel.v(j);
+        let bond = Bond {
+            normal,
+            gap_m: dist - reach,
+            centre_distance_m: dist,
+            well_distance_m: c.well_ratio * reach,
+            effective_radius_m: ri * rj / reach,
+            effective_mass_kg: mi * mj / (mi + mj),
+            approach_m_per_s: -u.dot(&normal),
+            contact_velocity: u - (bi.w * ri + vel.w(j) * rj).cross(&normal),
+            depth_factor: 1.0,
+        };
+        let mut state = cohesion_state(hist, k);
+        let bridge = self.bridges.pair.get(slot).unwrap_or(&BridgeConstants::NONE);
+        let out = c.force(&bond, &mut state, bridge, self.dt_s);
+        hist.cohesion.in_well[k] = state.in_well;
+        *crossings += u64::from(out.crossed_well);
+        let nxft = normal.cross(&out.tangential_n);
+        PairResult {
+            force: normal * out.normal_n + out.tangential_n,
+            torque_i: -(nxft * ri),
+            torque_j: -(nxft * rj),
+            scalars: ScalarFlows::ZERO,
+        }
+    }
+
+    /// Adds the wall contacts and wall cohesion of particle i (velocity `vi`, angular velocity `wi`) to (f, t), in
+    /// ascending wall order; `hist` holds exactly i's wall slots, the first of which is slot `first_slot_global` of
+    /// the whole list. Returns the walls' flows into i's channels (zero unless the run records them).
     #[allow(clippy::too_many_arguments)]
     #[inline(always)]
-    fn walls<const WB: bool, const TH: bool>(
+    fn walls<P: PassKind>(
         &self,
         i: usize,
         x: Vec3,
@@ -344,20 +528,77 @@ impl<'a> Context<'a> {
         wall_ids: &[u16],
         hist: &mut ColumnsMut,
         first_slot: usize,
+        first_slot_global: usize,
         f: &mut Vec3,
         t: &mut Vec3,
         worst: &mut WorstOverlap,
-    ) {
-        let ri = self.radius_m[i];
+        crossings: &mut u64,
+    ) -> ScalarFlows {
+        let mut flows = ScalarFlows::ZERO;
+        let mut touches_a_wall = false;
         for (offset, &w) in wall_ids.iter().enumerate() {
-            let k = first_slot + offset;
-            let wall = &self.config.walls[w as usize];
-            let prox = wall.proximity(&x, self.wall_angle[w as usize]);
-            let overlap = ri - prox.gap_m;
-            if overlap <= 0.0 {
-                hist.release_as::<ContactLayout<WB, TH>>(k);
-                continue;
+            let (contact, bond, ended) = self.wall_slot::<P>(
+                i,
+                x,
+                vi,
+                wi,
+                w,
+                hist,
+                first_slot + offset,
+                first_slot_global + offset,
+                worst,
+                crossings,
+            );
+            if let Some((force, torque)) = contact {
+                *f += force;
+                *t += torque;
+                touches_a_wall = true;
             }
+            if P::WIDE {
+                if let Some((force, torque)) = bond {
+                    *f += force;
+                    *t += torque;
+                }
+                if let Some(ended) = ended {
+                    flows.add(&ended);
+                }
+            }
+        }
+        if P::WIDE && self.channels && touches_a_wall {
+            flows.wall_contact_time_s += self.dt_s;
+        }
+        flows
+    }
+
+    /// One wall slot of particle i (local slot `k`, slot `slot` of the whole list): the contact law's force and
+    /// torque on i while it overlaps the wall (otherwise the contact history is released), and the cohesion model's
+    /// while it acts, the wall a partner of infinite radius and mass (R* = R_i, μ = m_i, a square well twice as
+    /// deep: seed 001 §6.2.4.2). Third: the flows of a contact that ended here (where the run records channels).
+    #[allow(clippy::too_many_arguments)]
+    #[inline(always)]
+    fn wall_slot<P: PassKind>(
+        &self,
+        i: usize,
+        x: Vec3,
+        vi: Vec3,
+        wi: Vec3,
+        w: u16,
+        hist: &mut ColumnsMut,
+        k: usize,
+        slot: usize,
+        worst: &mut WorstOverlap,
+        crossings: &mut u64,
+    ) -> (Option<(Vec3, Vec3)>, Option<(Vec3, Vec3)>, Option<ScalarFlows>) {
+        let ri = self.radius_m[i];
+        let wall = &self.config.walls[w as usize];
+        let prox = wall.proximity(&x, self.wall_angle[w as usize]);
+        let overlap = ri - prox.gap_m;
+        let mut ended = None;
+        let contact = if overlap <= 0.0 {
+            ended = self.contact_ended::<P>(hist, k, true);
+            hist.release_as::<P>(k);
+            None
+        } else {
             worst.note(overlap, ri, i, u32::MAX - w as u32);
             let n = prox.normal;
             let kin = ContactKinematics {
@@ -370,20 +611,52 @@ impl<'a> Context<'a> {
                 relative_angular_velocity: wi - prox.wall_angular_velocity,
             };
             let mat = self.table.get(self.species[i], wall.species);
-            let mut h = hist.load_as::<ContactLayout<WB, TH>>(k);
+            let mut h = hist.load_as::<P>(k);
             let out = self.law.evaluate(mat, &kin, self.dt_s, &mut h);
-            hist.save_as::<ContactLayout<WB, TH>>(k, &h);
-            *f += out.force;
-            *t += -(n.cross(&out.tangential_force) * ri) + out.rolling_torque;
+            hist.save_as::<P>(k, &h);
+            self.contact_lasts::<P>(hist, k);
+            Some((out.force, -(n.cross(&out.tangential_force) * ri) + out.rolling_torque))
+        };
+        if !P::WIDE {
+            return (contact, None, None);
         }
+        let Some(c) = self
+            .cohesion
+            .filter(|c| c.wall_range_m > 0.0 && c.wall_on.get(w as usize).copied().unwrap_or(true))
+        else {
+            return (contact, None, ended);
+        };
+        let gap = prox.gap_m - ri;
+        let mut state = cohesion_state(hist, k);
+        if gap >= c.wall_range_m && state.is_empty() {
+            return (contact, None, ended);
+        }
+        let n = prox.normal;
+        let bond = Bond {
+            normal: n,
+            gap_m: gap,
+            centre_distance_m: prox.gap_m,
+            well_distance_m: c.well_ratio * ri,
+            effective_radius_m: ri,
+            effective_mass_kg: self.mass_kg[i],
+            approach_m_per_s: -(vi - prox.wall_velocity).dot(&n),
+            contact_velocity: vi - prox.wall_velocity - (wi * ri).cross(&n),
+            depth_factor: 2.0,
+        };
+        let bridge = self.bridges.wall.get(slot).unwrap_or(&BridgeConstants::NONE);
+        let out = c.force(&bond, &mut state, bridge, self.dt_s);
+        hist.cohesion.in_well[k] = state.in_well;
+        *crossings += u64::from(out.crossed_well);
+        let force = n * out.normal_n + out.tangential_n;
+        (contact, Some((force, -(n.cross(&out.tangential_n) * ri))), ended)
     }
 
     /// Completes particle i once all its pair contributions are in (f, t): its walls, then [`Context::finish`],
-    /// storing the new motion. `wall_ids` are i's walls, whose history is in `walls` from `first_wall_slot` on.
-    /// Returns the final (f, t).
+    /// storing the new motion. `wall_ids` are i's walls, whose history is in `walls` from `first_wall_slot` on (slot
+    /// `first_wall_slot_global` of the whole list). Returns the final (f, t) and the walls' flows into i's channels.
     #[allow(clippy::too_many_arguments)]
     #[inline(always)]
-    fn complete<const WB: bool, const TH: bool>(
+    fn complete<P: PassKind>(
         &self,
         i: usize,
         mut f: Vec3,
@@ -392,10 +665,11 @@ impl<'a> Context<'a> {
         wall_ids: &[u16],
         walls: &mut ColumnsMut,
         first_wall_slot: usize,
+        first_wall_slot_global: usize,
         tally: &mut Tally,
-    ) -> (Vec3, Vec3) {
+    ) -> (Vec3, Vec3, ScalarFlows) {
         let (xi, vi, wi) = (motion.x(i), motion.v(i), motion.w(i));
-        self.walls::<WB, TH>(
+        let flows = self.walls::<P>(
             i,
             xi,
             vi,
@@ -403,19 +677,21 @@ impl<'a> Context<'a> {
             wall_ids,
             walls,
             first_wall_slot,
+            first_wall_slot_global,
             &mut f,
             &mut t,
             &mut tally.worst,
+            &mut tally.well_crossings,
         );
         let (x_new, v_new, w_new, d2) = self.finish(i, &mut f, &mut t, xi, vi, wi);
         tally.velocity_sum += (v_new.x + v_new.y + v_new.z) + (w_new.x + w_new.y + w_new.z);
         tally.max_displacement2 = tally.max_displacement2.max(d2);
         motion.set(i, x_new, v_new, w_new);
         if self.kick.is_some_and(|k| k.fuse_next_drift) {
-            // The next step's pass accumulates into these arrays: leave them zero (see `compute_contact_forces`).
-            (Vec3::zeros(), Vec3::zeros())
+            // The next step's pass accumulates into these arrays: leave them zero (see `compute_pair_forces`).
+            (Vec3::zeros(), Vec3::zeros(), flows)
         } else {
-            (f, t)
+            (f, t, flows)
         }
     }
 
@@ -462,6 +738,15 @@ impl<'a> Context<'a> {
     }
 }
 
+/// The cohesion slot of local slot `k` (the view must have the cohesion columns).
+#[inline(always)]
+fn cohesion_state(hist: &ColumnsMut, k: usize) -> CohesionHistory {
+    CohesionHistory {
+        bridge_volume_m3: hist.cohesion.bridge_volume_m3[k],
+        in_well: hist.cohesion.in_well[k],
+    }
+}
+
 /// What a loop over particles accumulates besides forces.
 #[derive(Debug, Clone, Copy)]
 struct Tally {
@@ -469,6 +754,8 @@ struct Tally {
     /// A NaN or infinity in any kicked velocity propagates into this sum; the culprit is looked for only then.
     velocity_sum: f64,
     max_displacement2: f64,
+    /// Square-well crossings.
+    well_crossings: u64,
 }
 
 impl Tally {
@@ -477,6 +764,7 @@ impl Tally {
         self.worst = self.worst.max(later.worst);
         self.velocity_sum += later.velocity_sum;
         self.max_displacement2 = self.max_displacement2.max(later.max_displacement2);
+        self.well_crossings += later.well_crossings;
     }
 }
 
@@ -486,6 +774,7 @@ impl Default for Tally {
             worst: WorstOverlap::NONE,
             velocity_sum: 0.0,
             max_displacement2: 0.0,
+            well_crossings: 0,
         }
     }
 }
@@ -516,17 +805,21 @@ pub struct ForcePass {
     pub non_finite: Option<usize>,
     /// With a fused drift: the largest squared displacement from the neighbour-list reference positions.
     pub max_displacement2_m2: f64,
+    /// Square-well crossings in this pass.
+    pub well_crossings: u64,
 }
 
-/// Computes contact forces and torques into `p.force_n` and `p.torque_n_m` and, with `kick`, applies the second
-/// half kick to every particle.
+/// Computes the forces and torques of every pair and wall slot into `p.force_n` and `p.torque_n_m` (adding onto
+/// what they hold, e.g. the gas's forces) and, with `kick`, applies the second half kick to every particle.
+/// `cohesion`: the cohesion model when it acts this step, with `bridges` the constants of the standing bridges.
+/// Where the run records channels (`p.channels` not empty) the pass adds into them and times the contacts.
 ///
 /// The force and torque arrays are the accumulators of the pass. When the kick fuses the next step's drift, the
 /// totals are consumed at once and the arrays are left zero instead, so that the next pass (told so by
 /// `accumulators_zeroed`) need not clear them: a sweep over 48 bytes per particle saved per step. The totals are
 /// stored by every pass that does not fuse, which is the last step of every `Simulation::run_steps`.
 #[allow(clippy::too_many_arguments)]
-pub fn compute_contact_forces(
+pub fn compute_pair_forces(
     config: &SimConfig,
     p: &mut Particles,
     inverse: &InverseInertia,
@@ -539,12 +832,16 @@ pub fn compute_contact_forces(
     team: &Team,
     kick: Option<HalfKick>,
     accumulators_zeroed: bool,
+    cohesion: Option<&Cohesion>,
+    bridges: &BridgeCache,
 ) -> ForcePass {
     let mut force = std::mem::take(&mut p.force_n);
     let mut torque = std::mem::take(&mut p.torque_n_m);
     let mut position = std::mem::take(&mut p.position_m);
     let mut velocity = std::mem::take(&mut p.velocity_m_per_s);
     let mut omega = std::mem::take(&mut p.angular_velocity_rad_per_s);
+    let mut channels = std::mem::take(&mut p.channels);
+    let channels_on = channels.is_on();
     let reference = if list.reference_positions().len() == position.len() {
         list.reference_positions()
     } else {
@@ -559,14 +856,17 @@ pub fn compute_contact_forces(
         kick,
         reference,
         accumulators_zeroed,
+        cohesion,
+        bridges,
+        channels_on,
     );
-    // One instantiation per history layout: the layout decides which history fields exist, and knowing it at
-    // compile time lets the kernels' unused fields vanish from the loop.
+    // One instantiation per pass kind: the layout decides which history fields exist, and knowing it at compile
+    // time lets the kernels' unused fields vanish from the loop; a dry run has no cohesion code in it.
     let layout = config.contact_law.history_layout();
     macro_rules! run {
-        ($wb:literal, $th:literal) => {
+        ($wb:literal, $th:literal, $co:literal) => {
             if team.size() == 1 || plan.bounds.len() <= 2 {
-                serial::<$wb, $th>(
+                serial::<Pass<$wb, $th, $co>>(
                     &ctx,
                     list,
                     history,
@@ -575,9 +875,10 @@ pub fn compute_contact_forces(
                     &mut position,
                     &mut velocity,
                     &mut omega,
+                    &mut channels,
                 )
             } else {
-                parallel::<$wb, $th>(
+                parallel::<Pass<$wb, $th, $co>>(
                     &ctx,
                     list,
                     history,
@@ -587,32 +888,38 @@ pub fn compute_contact_forces(
                     &mut position,
                     &mut velocity,
                     &mut omega,
+                    &mut channels,
                     plan,
                     team,
                 )
             }
         };
     }
-    let pass = match (layout.walton_braun, layout.thornton) {
-        (false, false) => run!(false, false),
-        (true, false) => run!(true, false),
-        (false, true) => run!(false, true),
-        (true, true) => run!(true, true),
+    let pass = match (layout.walton_braun, layout.thornton, cohesion.is_some() || channels_on) {
+        (false, false, false) => run!(false, false, false),
+        (true, false, false) => run!(true, false, false),
+        (false, true, false) => run!(false, true, false),
+        (true, true, false) => run!(true, true, false),
+        (false, false, true) => run!(false, false, true),
+        (true, false, true) => run!(true, false, true),
+        (false, true, true) => run!(false, true, true),
+        (true, true, true) => run!(true, true, true),
     };
     p.force_n = force;
     p.torque_n_m = torque;
     p.position_m = position;
     p.velocity_m_per_s = velocity;
     p.angular_velocity_rad_per_s = omega;
+    p.channels = channels;
     pass
 }
 
-/// Adds each wall's contact force on all particles to `per_wall_n` (index = wall), exactly as the next force pass
-/// will compute it: same positions, velocities and history, the same kernel, with the history left untouched. For
-/// the net-force split ([`super::net_force`]); call it right before that pass. Particles are summed in ascending
-/// order, so the sums do not depend on the thread count.
+/// Adds each wall's contact force and cohesion force on all particles to `contact_n` and `cohesion_n` (index = wall),
+/// exactly as the next pair pass will compute them: same positions, velocities and history, the same kernels, with
+/// the history left untouched. For the net-force split ([`super::net_force`]); call it right before that pass.
+/// Particles are summed in ascending order, so the sums do not depend on the thread count.
 #[allow(clippy::too_many_arguments)]
-pub fn add_wall_contact_forces(
+pub fn add_wall_forces(
     config: &SimConfig,
     p: &Particles,
     inverse: &InverseInertia,
@@ -620,9 +927,25 @@ pub fn add_wall_contact_forces(
     dt_s: f64,
     list: &NeighborList,
     history: &AlignedHistory,
-    per_wall_n: &mut [Vec3],
+    cohesion: Option<&Cohesion>,
+    bridges: &BridgeCache,
+    contact_n: &mut [Vec3],
+    cohesion_n: &mut [Vec3],
 ) {
-    let ctx = Context::new(config, p, inverse, wall_angle, dt_s, None, &[], false);
+    // (Channels off: this pass only reads the forces, and leaves the history and the channels untouched.)
+    let ctx = Context::new(
+        config,
+        p,
+        inverse,
+        wall_angle,
+        dt_s,
+        None,
+        &[],
+        false,
+        cohesion,
+        bridges,
+        false,
+    );
     let motion = Plain {
         x: &p.position_m,
         v: &p.velocity_m_per_s,
@@ -631,41 +954,48 @@ pub fn add_wall_contact_forces(
     let mut scratch = history.wall.clone();
     let layout = config.contact_law.history_layout();
     macro_rules! run {
-        ($wb:literal, $th:literal) => {{
+        ($wb:literal, $th:literal, $co:literal) => {{
             let mut walls = scratch.view();
-            let mut worst = WorstOverlap::NONE;
+            let (mut worst, mut crossings) = (WorstOverlap::NONE, 0);
             for i in 0..p.len() {
-                let slots = list.walls_of(i);
-                for k in slots {
+                for k in list.walls_of(i) {
                     let wall = list.wall_partner[k];
-                    let (mut f, mut t) = (Vec3::zeros(), Vec3::zeros());
-                    ctx.walls::<$wb, $th>(
+                    let (contact, bond, _) = ctx.wall_slot::<Pass<$wb, $th, $co>>(
                         i,
                         motion.x(i),
                         motion.v(i),
                         motion.w(i),
-                        &[wall],
+                        wall,
                         &mut walls,
                         k,
-                        &mut f,
-                        &mut t,
+                        k,
                         &mut worst,
+                        &mut crossings,
                     );
-                    per_wall_n[wall as usize] += f;
+                    if let Some((force, _)) = contact {
+                        contact_n[wall as usize] += force;
+                    }
+                    if let Some((force, _)) = bond {
+                        cohesion_n[wall as usize] += force;
+                    }
                 }
             }
         }};
     }
-    match (layout.walton_braun, layout.thornton) {
-        (false, false) => run!(false, false),
-        (true, false) => run!(true, false),
-        (false, true) => run!(false, true),
-        (true, true) => run!(true, true),
+    match (layout.walton_braun, layout.thornton, cohesion.is_some()) {
+        (false, false, false) => run!(false, false, false),
+        (true, false, false) => run!(true, false, false),
+        (false, true, false) => run!(false, true, false),
+        (true, true, false) => run!(true, true, false),
+        (false, false, true) => run!(false, false, true),
+        (true, false, true) => run!(true, false, true),
+        (false, true, true) => run!(false, true, true),
+        (true, true, true) => run!(true, true, true),
     }
 }
 
 #[allow(clippy::too_many_arguments)]
-fn serial<const WB: bool, const TH: bool>(
+fn serial<P: PassKind>(
     ctx: &Context,
     list: &NeighborList,
     history: &mut AlignedHistory,
@@ -674,6 +1004,7 @@ fn serial<const WB: bool, const TH: bool>(
     position: &mut [Vec3],
     velocity: &mut [Vec3],
     omega: &mut [Vec3],
+    channels: &mut ParticleChannels,
 ) -> ForcePass {
     let ctx = *ctx;
     let n = ctx.radius_m.len();
@@ -685,11 +1016,24 @@ fn serial<const WB: bool, const TH: bool>(
     let motion = (&mut *position, &mut *velocity, &mut *omega);
     let no_buffers = PairBuffers::default();
     let (pairs, walls) = (history.pair.view(), history.wall.view());
-    let tally = sweep::<WB, TH, false>(ctx, &window, 0, 0..n, motion, force, torque, pairs, walls, &no_buffers);
+    let tally = sweep::<P, false>(
+        ctx,
+        &window,
+        0,
+        0..n,
+        motion,
+        force,
+        torque,
+        channels.view(),
+        pairs,
+        walls,
+        &no_buffers,
+    );
     ForcePass {
         worst_overlap: tally.worst,
         non_finite: first_non_finite(tally.velocity_sum, velocity, omega, 0),
         max_displacement2_m2: tally.max_displacement2,
+        well_crossings: tally.well_crossings,
     }
 }
 
@@ -703,7 +1047,7 @@ fn serial<const WB: bool, const TH: bool>(
 /// thus formed in the serial order, and only a boundary layer of pairs goes through memory twice. Which thread runs
 /// a range never matters: a range's results depend only on the plan.
 #[allow(clippy::too_many_arguments)]
-fn parallel<const WB: bool, const TH: bool>(
+fn parallel<P: PassKind>(
     ctx: &Context,
     list: &NeighborList,
     history: &mut AlignedHistory,
@@ -713,6 +1057,7 @@ fn parallel<const WB: bool, const TH: bool>(
     position: &mut [Vec3],
     velocity: &mut [Vec3],
     omega: &mut [Vec3],
+    channels: &mut ParticleChannels,
     plan: &RangePlan,
     team: &Team,
 ) -> ForcePass {
@@ -724,15 +1069,19 @@ fn parallel<const WB: bool, const TH: bool>(
     buffers.force_on_i.resize(n_slots, Vec3::zeros());
     buffers.torque_on_i.resize(n_slots, Vec3::zeros());
     buffers.torque_on_j.resize(n_slots, Vec3::zeros());
-    buffers.touching.resize(n_slots, false);
+    buffers.acted.resize(n_slots, false);
+    if ctx.channels {
+        buffers.scalars_on_i.resize(n_slots, ScalarFlows::ZERO);
+    }
 
     // Phase A: cross-range pairs, velocities only read.
-    let worst_cross = {
+    let (worst_cross, crossings_cross) = {
         let hist_parts = history.pair.split(&pair_ends);
         let f_parts = split_at_ends(&mut buffers.force_on_i, &pair_ends);
         let ti_parts = split_at_ends(&mut buffers.torque_on_i, &pair_ends);
         let tj_parts = split_at_ends(&mut buffers.torque_on_j, &pair_ends);
-        let on_parts = split_at_ends(&mut buffers.touching, &pair_ends);
+        let on_parts = split_at_ends(&mut buffers.acted, &pair_ends);
+        let scalar_parts = split_at_ends(&mut buffers.scalars_on_i, &pair_ends);
         let vel = Plain {
             x: position,
             v: velocity,
@@ -741,13 +1090,17 @@ fn parallel<const WB: bool, const TH: bool>(
         let parts: Vec<_> = hist_parts
             .into_iter()
             .zip(f_parts)
-            .zip(ti_parts.into_iter().zip(tj_parts.into_iter().zip(on_parts)))
+            .zip(
+                ti_parts
+                    .into_iter()
+                    .zip(tj_parts.into_iter().zip(on_parts.into_iter().zip(scalar_parts))),
+            )
             .collect();
-        team.map_parts(parts, |r, ((mut hist, fb), (tib, (tjb, onb)))| {
+        team.map_parts(parts, |r, ((mut hist, fb), (tib, (tjb, (onb, sb))))| {
             let ctx = *ctx;
             let (lo, hi) = (bounds[r], bounds[r + 1]);
             let base = list.start[lo] as usize;
-            let mut worst = WorstOverlap::NONE;
+            let (mut worst, mut crossings) = (WorstOverlap::NONE, 0u64);
             for i in plan.cross_from[r]..hi {
                 let bi = ctx.body(i, &vel);
                 for k in list.pairs_of(i) {
@@ -756,21 +1109,24 @@ fn parallel<const WB: bool, const TH: bool>(
                         continue;
                     }
                     let local = k - base;
-                    match ctx.pair::<WB, TH>(i, &bi, j, &vel, &mut hist, local, &mut worst) {
+                    match ctx.pair::<P>(i, &bi, j, &vel, &mut hist, local, k, &mut worst, &mut crossings) {
                         Some(res) => {
                             fb[local] = res.force;
                             tib[local] = res.torque_i;
                             tjb[local] = res.torque_j;
                             onb[local] = true;
+                            if P::WIDE && ctx.channels {
+                                sb[local] = res.scalars;
+                            }
                         }
                         None => onb[local] = false,
                     }
                 }
             }
-            worst
+            (worst, crossings)
         })
         .into_iter()
-        .fold(WorstOverlap::NONE, WorstOverlap::max)
+        .fold((WorstOverlap::NONE, 0), |a, b| (a.0.max(b.0), a.1 + b.1))
     };
 
     // Phase B: each range in the serial order.
@@ -782,49 +1138,55 @@ fn parallel<const WB: bool, const TH: bool>(
     let x_parts = split_at_ends(position, particle_ends);
     let v_parts = split_at_ends(velocity, particle_ends);
     let w_parts = split_at_ends(omega, particle_ends);
+    let channel_parts = channels.split(particle_ends);
     let parts: Vec<_> = f_parts
         .into_iter()
         .zip(t_parts)
         .zip(x_parts.into_iter().zip(v_parts.into_iter().zip(w_parts)))
-        .zip(hist_parts.into_iter().zip(wall_parts))
+        .zip(hist_parts.into_iter().zip(wall_parts.into_iter().zip(channel_parts)))
         .collect();
-    let (worst_ranges, non_finite, max_d2) = team
-        .map_parts(parts, |r, (((force, torque), (x, (v, w))), (pairs, walls))| {
-            let started = Instant::now();
-            let range = RangeData {
-                ctx,
-                plan,
-                list,
-                buffers,
-            };
-            let tally = range_sweep::<WB, TH>(
-                &range,
-                ctx.config,
-                ctx.law,
-                ctx.table,
-                ctx.radius_m,
-                ctx.mass_kg,
-                ctx.species,
-                r,
-                force,
-                torque,
-                x,
-                v,
-                w,
-                pairs,
-                walls,
-            );
-            plan.busy_ns[r].fetch_add(started.elapsed().as_nanos() as u64, Ordering::Relaxed);
-            tally
-        })
+    let (worst_ranges, non_finite, max_d2, crossings_ranges) = team
+        .map_parts(
+            parts,
+            |r, (((force, torque), (x, (v, w))), (pairs, (walls, channels)))| {
+                let started = Instant::now();
+                let range = RangeData {
+                    ctx,
+                    plan,
+                    list,
+                    buffers,
+                };
+                let tally = range_sweep::<P>(
+                    &range,
+                    ctx.config,
+                    ctx.law,
+                    ctx.table,
+                    ctx.radius_m,
+                    ctx.mass_kg,
+                    ctx.species,
+                    r,
+                    force,
+                    torque,
+                    channels,
+                    x,
+                    v,
+                    w,
+                    pairs,
+                    walls,
+                );
+                plan.busy_ns[r].fetch_add(started.elapsed().as_nanos() as u64, Ordering::Relaxed);
+                tally
+            },
+        )
         .into_iter()
-        .fold((WorstOverlap::NONE, None, 0.0f64), |a, b| {
-            (a.0.max(b.0), a.1.min(b.1).or(a.1).or(b.1), a.2.max(b.2))
+        .fold((WorstOverlap::NONE, None, 0.0f64, 0u64), |a, b| {
+            (a.0.max(b.0), a.1.min(b.1).or(a.1).or(b.1), a.2.max(b.2), a.3 + b.3)
         });
     ForcePass {
         worst_overlap: worst_cross.max(worst_ranges),
         non_finite,
         max_displacement2_m2: max_d2,
+        well_crossings: crossings_cross + crossings_ranges,
     }
 }
 
@@ -841,7 +1203,7 @@ fn parallel<const WB: bool, const TH: bool>(
 /// the one explicit `mul_add` is exact either way (tests/portable_build.rs compares them).
 #[allow(clippy::too_many_arguments)]
 #[inline(never)]
-fn sweep<const WB: bool, const TH: bool, const CROSS: bool>(
+fn sweep<P: PassKind, const CROSS: bool>(
     ctx: Context,
     window: &ListWindow,
     lo: usize,
@@ -849,6 +1211,7 @@ fn sweep<const WB: bool, const TH: bool, const CROSS: bool>(
     motion: (&mut [Vec3], &mut [Vec3], &mut [Vec3]),
     force: &mut [Vec3],
     torque: &mut [Vec3],
+    channels: ChannelsMut,
     pairs: ColumnsMut,
     walls: ColumnsMut,
     buffers: &PairBuffers,
@@ -857,17 +1220,21 @@ fn sweep<const WB: bool, const TH: bool, const CROSS: bool>(
     if crate::machine::cpu_fast_path() {
         // SAFETY: `cpu_fast_path` is true only where the CPU has every feature `sweep_x86_64_v3` is compiled for.
         return unsafe {
-            sweep_x86_64_v3::<WB, TH, CROSS>(ctx, window, lo, particles, motion, force, torque, pairs, walls, buffers)
+            sweep_x86_64_v3::<P, CROSS>(
+                ctx, window, lo, particles, motion, force, torque, channels, pairs, walls, buffers,
+            )
         };
     }
-    sweep_body::<WB, TH, CROSS>(ctx, window, lo, particles, motion, force, torque, pairs, walls, buffers)
+    sweep_body::<P, CROSS>(
+        ctx, window, lo, particles, motion, force, torque, channels, pairs, walls, buffers,
+    )
 }
 
 /// [`sweep_body`] compiled for x86-64-v3's instructions.
 #[cfg(target_arch = "x86_64")]
 #[allow(clippy::too_many_arguments)]
 #[target_feature(enable = "avx,avx2,fma,bmi1,bmi2,lzcnt,popcnt,movbe")]
-fn sweep_x86_64_v3<const WB: bool, const TH: bool, const CROSS: bool>(
+fn sweep_x86_64_v3<P: PassKind, const CROSS: bool>(
     ctx: Context,
     window: &ListWindow,
     lo: usize,
@@ -875,17 +1242,20 @@ fn sweep_x86_64_v3<const WB: bool, const TH: bool, const CROSS: bool>(
     motion: (&mut [Vec3], &mut [Vec3], &mut [Vec3]),
     force: &mut [Vec3],
     torque: &mut [Vec3],
+    channels: ChannelsMut,
     pairs: ColumnsMut,
     walls: ColumnsMut,
     buffers: &PairBuffers,
 ) -> Tally {
-    sweep_body::<WB, TH, CROSS>(ctx, window, lo, particles, motion, force, torque, pairs, walls, buffers)
+    sweep_body::<P, CROSS>(
+        ctx, window, lo, particles, motion, force, torque, channels, pairs, walls, buffers,
+    )
 }
 
 /// The loop of [`sweep`], inlined into each of its compilations.
 #[allow(clippy::too_many_arguments)]
 #[inline(always)]
-fn sweep_body<const WB: bool, const TH: bool, const CROSS: bool>(
+fn sweep_body<P: PassKind, const CROSS: bool>(
     ctx: Context,
     window: &ListWindow,
     lo: usize,
@@ -893,6 +1263,7 @@ fn sweep_body<const WB: bool, const TH: bool, const CROSS: bool>(
     (x, v, w): (&mut [Vec3], &mut [Vec3], &mut [Vec3]),
     force: &mut [Vec3],
     torque: &mut [Vec3],
+    mut channels: ChannelsMut,
     mut pairs: ColumnsMut,
     mut walls: ColumnsMut,
     buffers: &PairBuffers,
@@ -909,22 +1280,40 @@ fn sweep_body<const WB: bool, const TH: bool, const CROSS: bool>(
         for (k, &j) in slots.clone().zip(&window.partner[slots]) {
             let j = j as usize - lo;
             if !CROSS || j < local_hi {
-                if let Some(res) = ctx.pair::<WB, TH>(il, &bi, j, motion, pairs, k, &mut tally.worst) {
+                let slot = k + window.pair_base;
+                if let Some(res) = ctx.pair::<P>(
+                    il,
+                    &bi,
+                    j,
+                    motion,
+                    pairs,
+                    k,
+                    slot,
+                    &mut tally.worst,
+                    &mut tally.well_crossings,
+                ) {
                     force[il] += res.force;
                     force[j] -= res.force;
                     torque[il] += res.torque_i;
                     torque[j] += res.torque_j;
+                    if P::WIDE && ctx.channels {
+                        channels.add(il, &res.scalars);
+                        channels.add(j, &res.scalars.for_partner());
+                    }
                 }
             } else {
                 let k = k + window.pair_base;
-                if buffers.touching[k] {
+                if buffers.acted[k] {
                     force[il] += buffers.force_on_i[k];
                     torque[il] += buffers.torque_on_i[k];
+                    if P::WIDE && ctx.channels {
+                        channels.add(il, &buffers.scalars_on_i[k]);
+                    }
                 }
             }
         }
         let wall_slots = window.walls_of(il);
-        let (f, t) = ctx.complete::<WB, TH>(
+        let (f, t, flows) = ctx.complete::<P>(
             il,
             force[il],
             torque[il],
@@ -932,10 +1321,14 @@ fn sweep_body<const WB: bool, const TH: bool, const CROSS: bool>(
             &window.wall_partner[wall_slots.clone()],
             walls,
             wall_slots.start,
+            wall_slots.start + window.wall_base,
             &mut tally,
         );
         force[il] = f;
         torque[il] = t;
+        if P::WIDE && ctx.channels {
+            channels.add(il, &flows);
+        }
     }
     tally
 }
@@ -998,7 +1391,7 @@ struct RangeData<'a> {
 ///   as one shared function the two differ by 1-1.5 %.
 #[allow(clippy::too_many_arguments)]
 #[inline(never)]
-fn range_sweep<const WB: bool, const TH: bool>(
+fn range_sweep<P: PassKind>(
     range: &RangeData,
     config: &SimConfig,
     law: &ContactLaw,
@@ -1009,12 +1402,13 @@ fn range_sweep<const WB: bool, const TH: bool>(
     r: usize,
     force: &mut [Vec3],
     torque: &mut [Vec3],
+    mut channels: ChannelsMut,
     x: &mut [Vec3],
     v: &mut [Vec3],
     w: &mut [Vec3],
     mut pairs: ColumnsMut,
     mut walls: ColumnsMut,
-) -> (WorstOverlap, Option<usize>, f64) {
+) -> (WorstOverlap, Option<usize>, f64, u64) {
     let (plan, list, buffers) = (range.plan, range.list, range.buffers);
     let (lo, hi) = (plan.bounds[r], plan.bounds[r + 1]);
     // Everything below is indexed relative to the range: particle il is lo + il, pair slot k is pair_base + k.
@@ -1039,16 +1433,19 @@ fn range_sweep<const WB: bool, const TH: bool>(
     // Contributions from earlier ranges come first in the serial order (ascending first particle).
     for &(k, j) in &plan.incoming[plan.incoming_start[r]..plan.incoming_start[r + 1]] {
         let (k, j) = (k as usize, j as usize - lo);
-        if buffers.touching[k] {
+        if buffers.acted[k] {
             force[j] -= buffers.force_on_i[k];
             torque[j] += buffers.torque_on_j[k];
+            if P::WIDE && ctx.channels {
+                channels.add(j, &buffers.scalars_on_i[k].for_partner());
+            }
         }
     }
     let local_hi = hi - lo;
     let cross_from = plan.cross_from[r] - lo;
     let interior = (&mut *x, &mut *v, &mut *w);
     let (interior_pairs, interior_walls) = (pairs.reborrow(), walls.reborrow());
-    let mut tally = sweep::<WB, TH, false>(
+    let mut tally = sweep::<P, false>(
         ctx,
         &window,
         lo,
@@ -1056,11 +1453,12 @@ fn range_sweep<const WB: bool, const TH: bool>(
         interior,
         force,
         torque,
+        channels.reborrow(),
         interior_pairs,
         interior_walls,
         buffers,
     );
-    let layer = sweep::<WB, TH, true>(
+    let layer = sweep::<P, true>(
         ctx,
         &window,
         lo,
@@ -1068,6 +1466,7 @@ fn range_sweep<const WB: bool, const TH: bool>(
         (x, v, w),
         force,
         torque,
+        channels,
         pairs,
         walls,
         buffers,
@@ -1078,5 +1477,6 @@ fn range_sweep<const WB: bool, const TH: bool>(
         tally.worst,
         first_non_finite(tally.velocity_sum, v, w, lo),
         tally.max_displacement2,
+        tally.well_crossings,
     )
 }

@@ -9,6 +9,7 @@
 use serde::{Deserialize, Serialize};
 
 use super::Vec3;
+use super::channels::ParticleChannels;
 
 /// Stable identity of a particle. Never reused within one simulation.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash, Serialize, Deserialize, schemars::JsonSchema)]
@@ -106,7 +107,7 @@ impl SpeciesTable {
     }
 }
 
-/// The particle arrays. All `Vec`s have the same length.
+/// The particle arrays. All `Vec`s have the same length (the channels' columns that length or empty).
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct Particles {
     pub id: Vec<ParticleId>,
@@ -126,6 +127,8 @@ pub struct Particles {
     pub liquid_m3: Vec<f64>,
     /// Liquid the particle has received from the spray since the start, m³ (for the coating variability CV_m).
     pub sprayed_m3: Vec<f64>,
+    /// The scalar channels the pair pass adds into (`engine::channels`; empty columns when the run records none).
+    pub channels: ParticleChannels,
 }
 
 impl Particles {
@@ -153,6 +156,7 @@ impl Particles {
         self.torque_n_m.push(Vec3::zeros());
         self.liquid_m3.push(species.liquid_content * radius_m.powi(3));
         self.sprayed_m3.push(0.0);
+        self.channels.push_zero();
         id
     }
 

@@ -8,18 +8,17 @@
 use std::sync::Arc;
 use std::time::{Duration, Instant};
 
-use super::cohesion::{BridgeCache, CohesionPass, apply_cohesion, total_liquid_m3};
+use super::cohesion::CohesionEvents;
 pub use super::config::SimConfig;
 use super::contacts::AlignedHistory;
 use super::gas::coupled::GasCoupling;
 use super::integrate::{InverseInertia, find_lost, kick_drift};
-use super::models::cohesion_law::{CohesionModel, LiquidBridge};
+use super::liquid::{BridgeCache, step_liquid, total_liquid_m3};
 use super::neighbor::{Criteria, NeighborList};
 use super::net_force::NetForceTally;
-use super::pair_pass::{ForcePass, HalfKick, PairBuffers, add_wall_contact_forces, compute_contact_forces};
+use super::pair_pass::{ForcePass, HalfKick, PairBuffers, add_wall_forces, compute_pair_forces};
 use super::particles::{ParticleId, Particles};
 use super::range_plan::RangePlan;
-use super::spray::spray_surface;
 use super::state::{RngState, SimState};
 use super::team::Team;
 use super::{NumericalError, Vec3};
@@ -41,8 +40,8 @@ pub struct StageTimers {
     pub gas: Duration,
     /// The gas's forces on the particles and their reaction (inside `force`).
     pub fluid_forces: Duration,
-    /// The cohesion pass (inside `force`).
-    pub cohesion: Duration,
+    /// The liquid inventory's events (inside `force`).
+    pub liquid: Duration,
 }
 
 pub struct Simulation {
@@ -62,10 +61,10 @@ pub struct Simulation {
     refilters: u64,
     /// Contact histories and cohesion states, aligned with `list`.
     history: AlignedHistory,
-    /// The cohesion pass's per-slot bridge constants (workspace).
+    /// The standing bridges' constants per slot of `list` (workspace, kept by the liquid inventory).
     bridges: BridgeCache,
     /// Events of the cohesion passes since the start of this process.
-    pub cohesion_events: CohesionPass,
+    pub cohesion_events: CohesionEvents,
     /// Liquid sprayed since the start of this process, m³ (the state keeps it per particle).
     pub sprayed_m3: f64,
     buffers: PairBuffers,
@@ -119,7 +118,7 @@ impl Simulation {
             refilters: 0,
             history: AlignedHistory::default(),
             bridges: BridgeCache::default(),
-            cohesion_events: CohesionPass::default(),
+            cohesion_events: CohesionEvents::default(),
             sprayed_m3: 0.0,
             buffers: PairBuffers::default(),
             inverse,
@@ -134,8 +133,8 @@ impl Simulation {
             timers: StageTimers::default(),
         };
         sim.refresh_neighbors();
-        // The first half kick needs F(0). With dt = 0 the tangential springs do not move.
-        sim.apply_cohesion(0.0);
+        // The first half kick needs F(0). With dt = 0 the tangential springs do not move (and nothing is sprayed).
+        sim.step_liquid(0.0);
         let pass = sim.forces(0.0, None);
         sim.check_overlap(pass.worst_overlap)?;
         Ok(sim)
@@ -157,7 +156,7 @@ impl Simulation {
             refilters: 0,
             history: AlignedHistory::default(),
             bridges: BridgeCache::default(),
-            cohesion_events: CohesionPass::default(),
+            cohesion_events: CohesionEvents::default(),
             sprayed_m3: 0.0,
             buffers: PairBuffers::default(),
             inverse,
@@ -211,9 +210,9 @@ impl Simulation {
             ("dem_neighbor".into(), self.timers.neighbor.as_secs_f64()),
             (
                 "dem_contact_forces".into(),
-                (self.timers.force - self.timers.fluid_forces - self.timers.cohesion).as_secs_f64(),
+                (self.timers.force - self.timers.fluid_forces - self.timers.liquid).as_secs_f64(),
             ),
-            ("dem_cohesion".into(), self.timers.cohesion.as_secs_f64()),
+            ("dem_liquid".into(), self.timers.liquid.as_secs_f64()),
             (
                 "fluid_forces_on_particles".into(),
                 self.timers.fluid_forces.as_secs_f64(),
@@ -406,14 +405,14 @@ impl Simulation {
             }
             self.timers.fluid_forces += t.elapsed();
         }
-        self.apply_cohesion(dt);
+        self.step_liquid(dt);
         let kick = HalfKick {
             gravity: config.gravity.at(self.time_s),
             dt_s: dt,
             fuse_next_drift,
         };
         if let Some(tally) = self.net_force.as_mut() {
-            add_wall_contact_forces(
+            add_wall_forces(
                 &config,
                 &self.particles,
                 &self.inverse,
@@ -421,7 +420,10 @@ impl Simulation {
                 dt,
                 &self.list,
                 &self.history,
+                config.cohesion.as_ref(),
+                &self.bridges,
                 &mut tally.wall_contact_n,
+                &mut tally.wall_cohesion_n,
             );
             tally.steps += 1;
         }
@@ -477,9 +479,10 @@ impl Simulation {
         Ok(())
     }
 
-    /// Contact forces at the current positions; with `kick`, also the second half kick.
+    /// The pair pass's forces at the current positions (contacts, and cohesion in a cohesive run); with `kick`, also
+    /// the second half kick.
     fn forces(&mut self, dt: f64, kick: Option<HalfKick>) -> ForcePass {
-        let pass = compute_contact_forces(
+        let pass = compute_pair_forces(
             &self.config,
             &mut self.particles,
             &self.inverse,
@@ -492,53 +495,38 @@ impl Simulation {
             &self.team,
             kick,
             self.accumulators_zeroed,
+            self.config.cohesion.as_ref(),
+            &self.bridges,
         );
         self.accumulators_zeroed = kick.is_some_and(|k| k.fuse_next_drift);
+        self.cohesion_events.well_crossings += pass.well_crossings;
         pass
     }
 
-    /// Adds the cohesion forces to the force arrays (zeroing them first if the last pass left them holding its
-    /// forces), so that the contact pass completes them.
-    fn apply_cohesion(&mut self, dt: f64) {
-        let Some(cohesion) = self.config.cohesion.as_ref() else {
+    /// The liquid inventory's step in a run with liquid bridges: the spray when it is due, then bridge formation and
+    /// rupture at the current positions (`engine::liquid`).
+    fn step_liquid(&mut self, dt: f64) {
+        let config = Arc::clone(&self.config);
+        let Some(cohesion) = config.cohesion.as_ref() else {
             return;
         };
         let t = Instant::now();
-        if let CohesionModel::LiquidBridge(LiquidBridge { spray: Some(spray), .. }) = cohesion.model
-            && dt > 0.0
-            && self.time_s >= spray.start_s
-            && self.step.is_multiple_of(spray.every_steps)
-        {
-            let g = self.config.gravity.at(self.time_s);
-            self.sprayed_m3 += spray_surface(&mut self.particles, &g, spray.max_liquid_content);
-        }
-        // Before `bridges_from_s` no bridge exists yet, so the pass has nothing to do (and must form none).
-        if let CohesionModel::LiquidBridge(b) = cohesion.model
-            && self.time_s < b.bridges_from_s
-        {
-            self.timers.cohesion += t.elapsed();
-            return;
-        }
-        if !self.accumulators_zeroed {
-            self.particles.force_n.iter_mut().for_each(|f| *f = Vec3::zeros());
-            self.particles.torque_n_m.iter_mut().for_each(|t| *t = Vec3::zeros());
-            self.accumulators_zeroed = true;
-        }
-        let pass = apply_cohesion(
+        let events = step_liquid(
             cohesion,
-            &self.config,
+            &config,
             &mut self.particles,
             &self.list,
             &mut self.history,
             &mut self.bridges,
             &self.wall_angle_rad,
+            self.time_s,
+            self.step,
             dt,
-            self.net_force.as_mut().map(|t| t.wall_cohesion_n.as_mut_slice()),
         );
-        self.cohesion_events.bridges_formed += pass.bridges_formed;
-        self.cohesion_events.bridges_ruptured += pass.bridges_ruptured;
-        self.cohesion_events.well_crossings += pass.well_crossings;
-        self.timers.cohesion += t.elapsed();
+        self.sprayed_m3 += events.sprayed_m3;
+        self.cohesion_events.bridges_formed += events.bridges_formed;
+        self.cohesion_events.bridges_ruptured += events.bridges_ruptured;
+        self.timers.liquid += t.elapsed();
     }
 
     /// Starts summing the net force on the particles by mechanism every step (see [`NetForceTally`]), unless

@@ -6,6 +6,7 @@ use rand_chacha::ChaCha8Rng;
 use rand_chacha::rand_core::SeedableRng;
 
 use super::Vec3;
+use super::channels::CHANNELS;
 use super::contacts::ContactStore;
 use super::gas::coupled::GasSnapshot;
 use super::models::ContactHistory;
@@ -240,4 +241,9 @@ pub fn first_difference(a: &SimState, b: &SimState) -> Option<String> {
         })
         .or_else(|| scalars("particles.liquid_m3", &p.liquid_m3, &q.liquid_m3))
         .or_else(|| scalars("particles.sprayed_m3", &p.sprayed_m3, &q.sprayed_m3))
+        .or_else(|| {
+            CHANNELS
+                .iter()
+                .find_map(|info| scalars(info.path, (info.get)(&p.channels), (info.get)(&q.channels)))
+        })
 }

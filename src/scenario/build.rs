@@ -12,6 +12,7 @@ use rand::RngExt;
 use super::ConfigError;
 use super::spec::{BaffleSpec, FillSpec, GravitySpec, ScenarioSpec, SpeciesSpec, WallSpec};
 use crate::engine::Vec3;
+use crate::engine::channels::ParticleChannels;
 use crate::engine::cohesion::Cohesion;
 use crate::engine::geometry::{Domain, Gravity, GravityFlip, RotatingFrame, Wall, WallShape};
 use crate::engine::models::cohesion_law::CohesionModel;
@@ -163,7 +164,8 @@ pub fn build(spec: ScenarioSpec, path: &Path) -> Result<BuiltScenario, ConfigErr
     check_memory(&c, &spec)?;
     let walls = build_walls(&c, &spec, &species, &domain)?;
     let mut rng = RngState::from_seed_u64(spec.seed).restore();
-    let particles = fill(&c, &spec, &species, &domain, &walls, &mut rng)?;
+    let mut particles = fill(&c, &spec, &species, &domain, &walls, &mut rng)?;
+    particles.channels = ParticleChannels::new(particles.len(), spec.output.contact_statistics);
 
     let skin_m = spec.neighbor.skin_m.unwrap_or(0.4 * particles.max_radius_m());
     c.positive("neighbor.skin_m", skin_m)?;
@@ -255,10 +257,12 @@ pub fn build(spec: ScenarioSpec, path: &Path) -> Result<BuiltScenario, ConfigErr
             )?)
         }
     };
+    let wall_species: Vec<_> = walls.iter().map(|w| w.species).collect();
     let mut cohesion = match spec.cohesion {
         None => None,
         Some(model) => Some(
-            Cohesion::new(model, &species, particles.max_radius_m()).map_err(|(key, message)| c.fail(key, message))?,
+            Cohesion::new(model, &species, &wall_species, particles.max_radius_m())
+                .map_err(|(key, message)| c.fail(key, message))?,
         ),
     };
     if let Some(off) = &spec.cohesion_off {
@@ -304,6 +308,7 @@ pub fn build(spec: ScenarioSpec, path: &Path) -> Result<BuiltScenario, ConfigErr
         inner_skin_auto: spec.neighbor.inner_skin_m.is_none(),
         max_overlap_fraction: spec.max_overlap_fraction,
         cohesion,
+        contact_statistics: spec.output.contact_statistics,
     };
     Ok(BuiltScenario {
         rng: RngState::capture(&rng),

@@ -292,6 +292,11 @@ pub struct OutputSpec {
     /// false.
     #[serde(default, skip_serializing_if = "std::ops::Not::not")]
     pub net_forces: bool,
+    /// Record every contact's duration and, per particle, the contacts that ended, their summed durations and the
+    /// time spent touching a wall (the metrics `mean_collision_duration_s`, `mean_wall_contact_duration_s`,
+    /// `wall_contact_time_fraction`). Adds the checkpoint's `particles/channels` datasets. Default: false.
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub contact_statistics: bool,
 }
 
 fn default_checkpoint_every() -> u64 {
@@ -311,6 +316,7 @@ impl Default for OutputSpec {
             keep_checkpoints: default_keep(),
             series_every_steps: default_series_every(),
             net_forces: false,
+            contact_statistics: false,
         }
     }
 }

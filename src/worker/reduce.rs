@@ -219,6 +219,9 @@ pub fn metrics(job: &JobSpec, built: &BuiltScenario, sim: &Simulation, series: &
                 | JobMetric::GranularCapillaryNumber12
                 | JobMetric::WetPhaseMixed => wet_number(metric, job, built, sim),
                 JobMetric::CoatingVariability => crate::engine::spray::coating_variability(&sim.particles.sprayed_m3),
+                JobMetric::MeanCollisionDuration => sim.particles.channels.mean_collision_duration_s(),
+                JobMetric::MeanWallContactDuration => sim.particles.channels.mean_wall_contact_duration_s(),
+                JobMetric::WallContactTimeFraction => sim.particles.channels.wall_contact_time_fraction(sim.time_s),
                 JobMetric::DefluidizationVelocity => cycle().map_or(f64::NAN, |c| c.velocities.defluidization_m_per_s),
                 JobMetric::FluidizationVelocityTheoretical => {
                     cycle().map_or(f64::NAN, |c| c.velocities.fluidization_theoretical_m_per_s)

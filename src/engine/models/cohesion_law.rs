@@ -67,7 +67,8 @@ pub enum CapillaryForce {
     /// Mikami's fit (seed 000 eqs 2.16–2.17) between particles of equal radius with contact angle 0, where it is
     /// settled against the exact bridge (within 5 %, VALIDATION B2); the Young–Laplace table (eqs 6.5–6.28) for
     /// every other pair (unequal radii or contact angles, or θ > 0, where Mikami's θ² term as printed is 15–160 %
-    /// above the exact bridge and with its sign flipped still 12–46 % off).
+    /// above the exact bridge and with its sign flipped still 12–46 % off). Bridges to walls always use the
+    /// sphere–plane table (Mikami's fit read at R* = R_i is 67–78 % below it near rupture).
     #[default]
     Auto,
     /// The Young–Laplace table for every pair.

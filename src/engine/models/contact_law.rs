@@ -65,6 +65,7 @@ impl ContactLaw {
             walton_braun: matches!(self.tangential, TangentialModel::WaltonBraun { .. }),
             thornton: matches!(self.normal, NormalModel::Thornton { .. }),
             cohesion: false,
+            contact_duration: false,
         }
     }
 

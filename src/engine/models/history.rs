@@ -10,7 +10,7 @@
 //! - [`HISTORY_FIELDS`], the table that the checkpoint's datasets (`checkpoint/layout.rs`) and the restart
 //!   comparison (`state::first_difference`) are built from, so a new field cannot be forgotten in either.
 //!
-//! Contact slots (normal, tangential) are cleared when the pair separates: a new contact starts from zero, which is
+//! Contact slots (normal, tangential, duration) are cleared when the pair separates: a new contact starts from zero, which is
 //! what all three seed models assume. Persistent slots (cohesion: a liquid bridge outlives the contact, a pair stays
 //! in a square well at a gap) keep their state until their own model clears it. What does not live here: the keyed
 //! store of records and its alignment with the neighbour list (`engine::contacts`), and the kernels (`normal.rs`,
@@ -29,6 +29,8 @@ pub struct HistoryLayout {
     pub thornton: bool,
     /// The cohesion slot (liquid bridges, the square well).
     pub cohesion: bool,
+    /// The duration slot (`output.contact_statistics`).
+    pub contact_duration: bool,
 }
 
 /// A history layout known at compile time: loads and stores of the fields it leaves out compile to nothing.
@@ -46,6 +48,7 @@ impl<const WB: bool, const TH: bool> StaticLayout for ContactLayout<WB, TH> {
         walton_braun: WB,
         thornton: TH,
         cohesion: false,
+        contact_duration: false,
     };
 }
 
@@ -403,6 +406,12 @@ contact_history! {
         /// Walton-Braun: unit direction of the last tangential force increment (zero before the first one).
         increment_direction: Vec3, "1", if walton_braun;
     }
+    /// The duration slot: how long the contact has lasted (`output.contact_statistics`; the pair pass adds the
+    /// duration of each contact that ends to the particles' contact-statistics channels, `engine::channels`).
+    contact duration: DurationHistory, DurationColumns, DurationColumnsMut {
+        /// Time since the contact began, s.
+        duration_s: f64, "s", if contact_duration;
+    }
     /// The cohesion slot: the state a cohesion model carries beyond contact.
     persistent cohesion: CohesionHistory, CohesionColumns, CohesionColumnsMut {
         /// Liquid bridge volume, m³ (0: no bridge).
@@ -478,6 +487,7 @@ mod tests {
             walton_braun: false,
             thornton: true,
             cohesion: true,
+            contact_duration: false,
         };
         let mut columns = HistoryColumns::new(2, layout);
         columns.view().save(1, &h);
