@@ -1,9 +1,11 @@
-//! `Simulation`: the configuration (immutable during a run), the state, and the workspace; `step()` advances one
-//! DEM time step.
+//! `Simulation`: the configuration (immutable during a run, `config.rs`), the state, the workspace and the timers;
+//! `step()` advances one DEM time step.
 //!
 //! A step is velocity Verlet: half kick with the forces of the previous step, drift, wall rotation, neighbour-list
-//! refresh if needed, contact forces, half kick, then the numerical checks (non-finite values, lost particles,
-//! excessive overlap), each reported as a [`NumericalError`] naming the step and particle.
+//! refresh if needed, the gas's forces, the liquid inventory's events (`liquid.rs`), the pair pass (contact and
+//! cohesion forces and the scalar channels, `pair_pass.rs`) with the second half kick fused in, then the numerical
+//! checks (non-finite values, lost particles, excessive overlap), each reported as a [`NumericalError`] naming the
+//! step and particle; the gas steps after every `dem_steps_per_gas_step`-th step.
 
 use std::sync::Arc;
 use std::time::{Duration, Instant};
@@ -44,14 +46,10 @@ pub struct StageTimers {
     pub liquid: Duration,
 }
 
-pub struct Simulation {
-    pub config: Arc<SimConfig>,
-    pub particles: Particles,
-    pub step: u64,
-    pub time_s: f64,
-    pub dt_s: f64,
-    pub wall_angle_rad: Vec<f64>,
-    pub rng: RngState,
+/// The simulation's workspace: what it keeps between steps only to go fast, none of it state (a simulation restored
+/// from a checkpoint rebuilds it): the neighbour lists, the standing bridges' constants, the parallel pass's buffers,
+/// ranges and thread team, the inverse masses, and the fused-step bookkeeping.
+struct Workspace {
     /// The force pass's list: every pair within the inner skin (`SimConfig::inner_skin_m`).
     list: NeighborList,
     /// The two-level scheme's outer list (pairs within `SimConfig::skin_m`), which `list` is refiltered from;
@@ -59,20 +57,12 @@ pub struct Simulation {
     candidates: NeighborList,
     /// Refilters of `list` from `candidates` in this process.
     refilters: u64,
-    /// Contact histories and cohesion states, aligned with `list`.
-    history: AlignedHistory,
-    /// The standing bridges' constants per slot of `list` (workspace, kept by the liquid inventory).
+    /// The standing bridges' constants per slot of `list` (kept by the liquid inventory, `liquid.rs`).
     bridges: BridgeCache,
-    /// Events of the cohesion passes since the start of this process.
-    pub cohesion_events: CohesionEvents,
-    /// Liquid sprayed since the start of this process, m³ (the state keeps it per particle).
-    pub sprayed_m3: f64,
     buffers: PairBuffers,
     inverse: InverseInertia,
     /// Particle ranges of the parallel force pass, rebalanced at every neighbour-list build.
     ranges: RangePlan,
-    /// Cost shares of one thread's ranges, front to back (see [`RangePlan::shares_for`]).
-    pub range_block: Vec<f64>,
     /// Set between two steps of one `run_steps` call when the force loop has already applied the next step's
     /// first half kick and drift: the largest squared displacement it found. Never set outside `run_steps`.
     pending_drift: Option<f64>,
@@ -83,7 +73,23 @@ pub struct Simulation {
     /// Threads of the per-step parallel force pass, which also run the drift of an unfused step and the neighbour
     /// lists' work (shared with that work through the `Arc`).
     team: Arc<Team>,
-    pub timers: StageTimers,
+}
+
+/// One simulation: its configuration (fixed for the run), its state (everything a checkpoint holds, and nothing
+/// else the next step depends on), its workspace, and what this process measured (timers and event counters).
+pub struct Simulation {
+    pub config: Arc<SimConfig>,
+
+    // The state (`snapshot()` gives it in its checkpointed form).
+    pub particles: Particles,
+    pub step: u64,
+    pub time_s: f64,
+    pub dt_s: f64,
+    pub wall_angle_rad: Vec<f64>,
+    pub rng: RngState,
+    /// The contact records (histories, cohesion states) aligned with the force pass's neighbour list: the state's
+    /// contacts in the form the pass streams through (`SimState::contacts` is their keyed, checkpointed form).
+    history: AlignedHistory,
     /// The gas, when the scenario has one. Its forces on the particles (under the frozen gas field) are
     /// evaluated once per step, at the new positions and half-step velocities, and loaded into the force arrays
     /// before the contact pass adds onto them, so the pass itself is unchanged and any thread count gives the same
@@ -92,6 +98,39 @@ pub struct Simulation {
     /// The net force on the particles by mechanism, summed every step when asked for
     /// ([`Simulation::record_net_forces`]); a diagnostic that never feeds back into the motion.
     pub net_force: Option<NetForceTally>,
+
+    // The workspace.
+    /// What the engine keeps between steps only to go fast (rebuilt from the state on restore).
+    work: Workspace,
+    /// Cost shares of one thread's ranges, front to back (see [`RangePlan::shares_for`]); a tuning knob of the
+    /// parallel pass that never changes a bit.
+    pub range_block: Vec<f64>,
+
+    // What this process measured.
+    pub timers: StageTimers,
+    /// Events of the cohesion passes since the start of this process.
+    pub cohesion_events: CohesionEvents,
+    /// Liquid sprayed since the start of this process, m³ (the state keeps it per particle).
+    pub sprayed_m3: f64,
+}
+
+impl Workspace {
+    /// Empty lists and buffers, built at the first step.
+    fn new(inverse: InverseInertia, threads: usize) -> Self {
+        Workspace {
+            list: NeighborList::default(),
+            candidates: NeighborList::default(),
+            refilters: 0,
+            bridges: BridgeCache::default(),
+            buffers: PairBuffers::default(),
+            inverse,
+            ranges: RangePlan::default(),
+            pending_drift: None,
+            accumulators_zeroed: false,
+            steps_since_rebalance: 0,
+            team: Arc::new(Team::new(threads)),
+        }
+    }
 }
 
 impl Simulation {
@@ -113,23 +152,13 @@ impl Simulation {
             dt_s,
             wall_angle_rad: vec![0.0; n_walls],
             rng,
-            list: NeighborList::default(),
-            candidates: NeighborList::default(),
-            refilters: 0,
             history: AlignedHistory::default(),
-            bridges: BridgeCache::default(),
+            work: Workspace::new(inverse, threads),
+            range_block: RangePlan::BLOCK.to_vec(),
             cohesion_events: CohesionEvents::default(),
             sprayed_m3: 0.0,
-            buffers: PairBuffers::default(),
-            inverse,
-            ranges: RangePlan::default(),
-            range_block: RangePlan::BLOCK.to_vec(),
-            pending_drift: None,
             gas: None,
             net_force: None,
-            accumulators_zeroed: false,
-            steps_since_rebalance: 0,
-            team: Arc::new(Team::new(threads)),
             timers: StageTimers::default(),
         };
         sim.refresh_neighbors();
@@ -151,30 +180,20 @@ impl Simulation {
             dt_s: state.dt_s,
             wall_angle_rad: state.wall_angle_rad,
             rng: state.rng,
-            list: NeighborList::default(),
-            candidates: NeighborList::default(),
-            refilters: 0,
             history: AlignedHistory::default(),
-            bridges: BridgeCache::default(),
+            work: Workspace::new(inverse, threads),
+            range_block: RangePlan::BLOCK.to_vec(),
             cohesion_events: CohesionEvents::default(),
             sprayed_m3: 0.0,
-            buffers: PairBuffers::default(),
-            inverse,
-            ranges: RangePlan::default(),
-            range_block: RangePlan::BLOCK.to_vec(),
-            pending_drift: None,
             gas: None,
             net_force: state.net_force,
-            accumulators_zeroed: false,
-            steps_since_rebalance: 0,
-            team: Arc::new(Team::new(threads)),
             timers: StageTimers::default(),
         };
-        let team = Arc::clone(&sim.team);
+        let team = Arc::clone(&sim.work.team);
         sim.build_lists(true, &team);
         let layout = sim.config.history_layout();
         let (history, orphans) =
-            AlignedHistory::from_store(&state.contacts, &sim.list, layout, &mut sim.particles.liquid_m3);
+            AlignedHistory::from_store(&state.contacts, &sim.work.list, layout, &mut sim.particles.liquid_m3);
         if orphans > 0 {
             return Err(NumericalError::OrphanContacts { count: orphans });
         }
@@ -191,7 +210,7 @@ impl Simulation {
             dt_s: self.dt_s,
             particles: self.particles.clone(),
             wall_angle_rad: self.wall_angle_rad.clone(),
-            contacts: self.history.to_store(&self.list),
+            contacts: self.history.to_store(&self.work.list),
             rng: self.rng,
             gas: self.gas.as_ref().map(|g| g.snapshot()),
             net_force: self.net_force.clone(),
@@ -199,7 +218,7 @@ impl Simulation {
     }
 
     pub fn threads(&self) -> usize {
-        self.team.size()
+        self.work.team.size()
     }
 
     /// This invocation's wall time per engine stage, seconds, by name (what a job's `result.json` and a
@@ -229,20 +248,20 @@ impl Simulation {
     /// Cell searches for neighbours in this process.
     pub fn neighbor_builds(&self) -> u64 {
         if self.two_level() {
-            self.candidates.builds
+            self.work.candidates.builds
         } else {
-            self.list.builds
+            self.work.list.builds
         }
     }
 
     /// Refilterings of the force pass's list from the outer candidates in this process (two-level scheme only).
     pub fn neighbor_refilters(&self) -> u64 {
-        self.refilters
+        self.work.refilters
     }
 
     /// Number of candidate pairs the force pass examines (each pair once).
     pub fn candidate_pairs(&self) -> usize {
-        self.list.pair_count()
+        self.work.list.pair_count()
     }
 
     fn two_level(&self) -> bool {
@@ -260,10 +279,10 @@ impl Simulation {
     /// Approximate heap bytes of state and workspace.
     pub fn heap_bytes(&self) -> usize {
         self.particles.heap_bytes()
-            + self.list.heap_bytes()
-            + self.candidates.heap_bytes()
+            + self.work.list.heap_bytes()
+            + self.work.candidates.heap_bytes()
             + self.history.heap_bytes()
-            + self.buffers.heap_bytes()
+            + self.work.buffers.heap_bytes()
     }
 
     /// Advances `n` steps.
@@ -285,11 +304,11 @@ impl Simulation {
             }
             Ok(())
         });
-        self.team.rest();
+        self.work.team.rest();
         if result.is_err() {
             // A failed step leaves no meaningful state; do not pretend the next step's drift is pending.
-            self.pending_drift = None;
-            self.accumulators_zeroed = false;
+            self.work.pending_drift = None;
+            self.work.accumulators_zeroed = false;
         }
         result
     }
@@ -328,14 +347,17 @@ impl Simulation {
         let dt = self.dt_s;
         let config = Arc::clone(&self.config);
         let t0 = Instant::now();
-        let max_displacement2 = match self.pending_drift.take() {
+        let max_displacement2 = match self.work.pending_drift.take() {
             // The previous step's force loop already kicked and drifted every particle.
             Some(d2) => d2,
             None => {
                 let g0 = config.gravity.at(self.time_s);
-                let (particles, inverse, reference) =
-                    (&mut self.particles, &self.inverse, self.list.reference_positions());
-                let team = &*self.team;
+                let (particles, inverse, reference) = (
+                    &mut self.particles,
+                    &self.work.inverse,
+                    self.work.list.reference_positions(),
+                );
+                let team = &*self.work.team;
                 kick_drift(
                     particles,
                     inverse,
@@ -354,7 +376,7 @@ impl Simulation {
         self.step += 1;
         self.time_s += dt;
         let t1 = Instant::now();
-        if self.list.needs_rebuild(
+        if self.work.list.needs_rebuild(
             self.particles.len(),
             max_displacement2,
             &config.walls,
@@ -364,7 +386,7 @@ impl Simulation {
                 &self.particles.position_m,
                 &config.domain,
                 self.particles.max_radius_m(),
-                &self.team,
+                &self.work.team,
             ) {
                 let position_m = self.particles.position_m[i];
                 return Err(if (position_m.x + position_m.y + position_m.z).is_finite() {
@@ -382,22 +404,22 @@ impl Simulation {
                 });
             }
             self.refresh_neighbors();
-        } else if self.threads() > 1 && self.steps_since_rebalance >= REBALANCE_EVERY_STEPS {
+        } else if self.threads() > 1 && self.work.steps_since_rebalance >= REBALANCE_EVERY_STEPS {
             self.rebalance();
         }
-        self.steps_since_rebalance += 1;
+        self.work.steps_since_rebalance += 1;
         let t2 = Instant::now();
         if let Some(fluid) = self.gas.as_mut().map(|g| &mut g.fluid) {
-            if !self.accumulators_zeroed {
+            if !self.work.accumulators_zeroed {
                 self.particles.force_n.iter_mut().for_each(|f| *f = Vec3::zeros());
                 self.particles.torque_n_m.iter_mut().for_each(|t| *t = Vec3::zeros());
-                self.accumulators_zeroed = true;
+                self.work.accumulators_zeroed = true;
             }
             let p = &mut self.particles;
             let t = Instant::now();
             // On the force pass's team, whose helpers are still spinning from the previous step (a rayon pool's
             // sleeping workers took tens of µs to wake, more than the work of a few thousand particles).
-            let team = (p.len() >= PARALLEL_FLUID_FORCES_MIN_PARTICLES).then_some(&*self.team);
+            let team = (p.len() >= PARALLEL_FLUID_FORCES_MIN_PARTICLES).then_some(&*self.work.team);
             fluid.add_forces(&p.position_m, &p.velocity_m_per_s, &p.radius_m, &mut p.force_n, team);
             if let Some(tally) = self.net_force.as_mut() {
                 // The arrays were zero: they hold exactly the gas's forces.
@@ -415,13 +437,13 @@ impl Simulation {
             add_wall_forces(
                 &config,
                 &self.particles,
-                &self.inverse,
+                &self.work.inverse,
                 &self.wall_angle_rad,
                 dt,
-                &self.list,
+                &self.work.list,
                 &self.history,
                 config.cohesion.as_ref(),
-                &self.bridges,
+                &self.work.bridges,
                 &mut tally.wall_contact_n,
                 &mut tally.wall_cohesion_n,
             );
@@ -429,7 +451,7 @@ impl Simulation {
         }
         let pass = self.forces(dt, Some(kick));
         if fuse_next_drift {
-            self.pending_drift = Some(pass.max_displacement2_m2);
+            self.work.pending_drift = Some(pass.max_displacement2_m2);
         }
         let t3 = Instant::now();
         self.timers.integrate += t1 - t0;
@@ -444,7 +466,7 @@ impl Simulation {
     fn non_finite(&self, i: usize) -> NumericalError {
         let p = &self.particles;
         let velocity_finite = p.velocity_m_per_s[i].iter().all(|a| a.is_finite());
-        let field = if self.accumulators_zeroed {
+        let field = if self.work.accumulators_zeroed {
             // The pass consumed the force and torque and left the arrays zero. Velocities were finite before the
             // kick and masses, dt and gravity are, so a non-finite velocity means a non-finite force, and a
             // non-finite angular velocity a non-finite torque.
@@ -485,20 +507,20 @@ impl Simulation {
         let pass = compute_pair_forces(
             &self.config,
             &mut self.particles,
-            &self.inverse,
+            &self.work.inverse,
             &self.wall_angle_rad,
             dt,
-            &self.list,
+            &self.work.list,
             &mut self.history,
-            &mut self.buffers,
-            &self.ranges,
-            &self.team,
+            &mut self.work.buffers,
+            &self.work.ranges,
+            &self.work.team,
             kick,
-            self.accumulators_zeroed,
+            self.work.accumulators_zeroed,
             self.config.cohesion.as_ref(),
-            &self.bridges,
+            &self.work.bridges,
         );
-        self.accumulators_zeroed = kick.is_some_and(|k| k.fuse_next_drift);
+        self.work.accumulators_zeroed = kick.is_some_and(|k| k.fuse_next_drift);
         self.cohesion_events.well_crossings += pass.well_crossings;
         pass
     }
@@ -515,9 +537,9 @@ impl Simulation {
             cohesion,
             &config,
             &mut self.particles,
-            &self.list,
+            &self.work.list,
             &mut self.history,
-            &mut self.bridges,
+            &mut self.work.bridges,
             &self.wall_angle_rad,
             self.time_s,
             self.step,
@@ -543,34 +565,34 @@ impl Simulation {
     }
 
     fn rebalance(&mut self) {
-        self.ranges = RangePlan::balanced(
-            &self.list,
+        self.work.ranges = RangePlan::balanced(
+            &self.work.list,
             &self.history.pair.touching,
             &RangePlan::shares_for(self.threads(), &self.range_block),
-            Some(&self.ranges),
-            &self.team,
+            Some(&self.work.ranges),
+            &self.work.team,
         );
-        self.steps_since_rebalance = 0;
+        self.work.steps_since_rebalance = 0;
     }
 
     fn refresh_neighbors(&mut self) {
-        let old_list = std::mem::take(&mut self.list);
-        self.list.builds = old_list.builds;
+        let old_list = std::mem::take(&mut self.work.list);
+        self.work.list.builds = old_list.builds;
         // On the force pass's team, whose helpers are spinning from the last pass (no wake-up to pay).
         // (A one-thread team runs everything on this thread.)
-        let team = Arc::clone(&self.team);
+        let team = Arc::clone(&self.work.team);
         let team = &*team;
         self.build_lists(self.needs_cell_search(), team);
         let layout = self.config.history_layout();
-        let (history, orphans) = self
-            .history
-            .remap(&old_list, &self.list, layout, &mut self.particles.liquid_m3, team);
+        let (history, orphans) =
+            self.history
+                .remap(&old_list, &self.work.list, layout, &mut self.particles.liquid_m3, team);
         // A contact is always a candidate of a list built from the same positions, and a bridge or well pair is
         // within the cohesion reach, hence a candidate too.
         debug_assert_eq!(orphans, 0, "contact histories lost in a neighbour-list rebuild");
         self.history = history;
         // The bridge constants are per slot of the old list.
-        self.bridges = BridgeCache::default();
+        self.work.bridges = BridgeCache::default();
         self.rebalance();
     }
 
@@ -581,13 +603,13 @@ impl Simulation {
         let c = &self.config;
         let allowance_m = 0.5 * (c.skin_m - c.inner_skin_m);
         !self.two_level()
-            || self.candidates.displaced_beyond(
+            || self.work.candidates.displaced_beyond(
                 &c.domain,
                 &self.particles.position_m,
                 &c.walls,
                 &self.wall_angle_rad,
                 allowance_m,
-                &self.team,
+                &self.work.team,
             )
     }
 
@@ -606,23 +628,23 @@ impl Simulation {
             pseudo_2d: c.pseudo_2d,
         };
         if !self.two_level() {
-            self.list.build(&outer, team);
+            self.work.list.build(&outer, team);
             return;
         }
         if searched {
-            self.candidates.build(&outer, team);
+            self.work.candidates.build(&outer, team);
         } else {
-            self.refilters += 1;
+            self.work.refilters += 1;
         }
         let inner = Criteria {
             skin_m: c.inner_skin_m,
             ..outer
         };
-        self.list.refilter(&self.candidates, &inner, team);
-        if searched && c.inner_skin_auto && 2 * self.list.pair_count() > self.candidates.pair_count() {
+        self.work.list.refilter(&self.work.candidates, &inner, team);
+        if searched && c.inner_skin_auto && 2 * self.work.list.pair_count() > self.work.candidates.pair_count() {
             // The inner skin does not halve the pairs the force pass examines (a loose or fast bed): refilters
             // would cost more than they save, so one level until the next cell search.
-            self.list.adopt(&self.candidates);
+            self.work.list.adopt(&self.work.candidates);
         }
     }
 
@@ -640,8 +662,8 @@ impl Simulation {
         };
         let mut e = 0.0;
         for i in 0..p.len() {
-            for k in self.list.pairs_of(i) {
-                let j = self.list.partner[k] as usize;
+            for k in self.work.list.pairs_of(i) {
+                let j = self.work.list.partner[k] as usize;
                 let d = c.domain.separation(&p.position_m[i], &p.position_m[j]).norm();
                 let overlap = p.radius_m[i] + p.radius_m[j] - d;
                 if overlap > 0.0 {
@@ -649,8 +671,8 @@ impl Simulation {
                     e += potential(c.pair_table.get(p.species[i], p.species[j]), r_star, overlap);
                 }
             }
-            for k in self.list.walls_of(i) {
-                let w = self.list.wall_partner[k] as usize;
+            for k in self.work.list.walls_of(i) {
+                let w = self.work.list.wall_partner[k] as usize;
                 let wall = &c.walls[w];
                 let overlap = p.radius_m[i] - wall.proximity(&p.position_m[i], self.wall_angle_rad[w]).gap_m;
                 if overlap > 0.0 {
