@@ -2,7 +2,7 @@
 //! half kick → drift → forces (with half-step velocities) → half kick.
 //!
 //! The first half kick, the drift, the lost-particle check and the neighbour-list displacement check are one pass
-//! over the particles ([`kick_drift`]); the second half kick is fused into the force pass (`forces.rs`). The
+//! over the particles ([`kick_drift`]); the second half kick is fused into the force pass (`pair_pass.rs`). The
 //! integrator is memory-bound, so passes, not arithmetic, set its cost. Each particle is updated independently, so the parallel loops are
 //! trivially deterministic.
 
@@ -56,7 +56,7 @@ pub fn half_kick_one(
 /// from `reference` (the positions at the last neighbour-list build; empty = skip). With a `team` of several
 /// threads, chunks run on it; with one, on the calling thread (per-particle arithmetic, so the same bits).
 ///
-/// No checks here: velocities were checked finite by the kick that made them (`forces.rs`), so positions stay
+/// No checks here: velocities were checked finite by the kick that made them (`pair_pass.rs`), so positions stay
 /// finite, and lost particles are looked for when the neighbour list is rebuilt (a particle cannot leave the box
 /// by a radius without moving more than half the skin).
 #[allow(clippy::too_many_arguments)]

@@ -1,10 +1,13 @@
 //! The pair pass: every force between two particles or a particle and a wall — the contact law and, in a cohesive
-//! run, the cohesion model's forces at a distance — on every particle, accumulated in one fixed order whatever the
-//! thread count.
+//! run, the cohesion model's forces at a distance — and every scalar channel's flow (`engine::channels`) on every
+//! particle, accumulated in one fixed order whatever the thread count.
 //!
 //! A wall is a partner like a particle, of infinite radius and mass with its own motion: each slot of the neighbour
 //! list (pair or wall) runs the same kernels, the contact law's (`models::contact_law`) while the pair overlaps and
-//! the cohesion model's (`engine::cohesion`) while it is in range or carries a state.
+//! the cohesion model's (`engine::cohesion`) while it is in range or carries a state. A slot's result carries its
+//! force, the torques on both particles and its channel flows (`PairResult`); the channels are summed beside the
+//! forces in the same order. A dry run that records no channels compiles to the contact loop alone (the narrow
+//! [`Pass`]); cohesion and channels are the wide pass's, each checked per slot at run time.
 //!
 //! The order for particle p is: first its contacts as the *second* particle of a pair (ascending first particle),
 //! then as the first particle (ascending partner), then its walls (ascending wall index). On one thread the pair loop
@@ -53,10 +56,9 @@ impl<const WB: bool, const TH: bool, const WIDE: bool> StaticLayout for Pass<WB,
         tangential: true,
         walton_braun: WB,
         thornton: TH,
-        // The cohesion and duration slots are read and written field by field where the run has them, never
+        // The other slots (cohesion, duration) are read and written field by field where the run has them, never
         // loaded whole.
-        cohesion: false,
-        contact_duration: false,
+        ..HistoryLayout::NONE
     };
 }
 
@@ -1385,10 +1387,8 @@ struct RangeData<'a> {
 ///   per-particle properties) are its parameters: a parameter reference is known not to alias the arrays written
 ///   in the loop, while one read from a struct must be reloaded after every store (−3 % instructions).
 /// - Particles with no partner beyond the range (all but a boundary layer) run [`sweep`], the one-thread pass's own
-///   loop, without the cross-range test: that test's second branch alone made the whole loop 12 % slower. Until
-///   2026-12-02 that interior was a copy of the loop inside this function, which ran 6-9 % slower than the same
-///   loop in the one-thread pass (measured in one process, the parallel pass on one thread against the serial);
-///   as one shared function the two differ by 1-1.5 %.
+///   loop, without the cross-range test: that test's second branch alone made the whole loop 12 % slower, and a
+///   copy of the loop here ran 6-9 % slower than the shared one (`docs/performance.md`).
 #[allow(clippy::too_many_arguments)]
 #[inline(never)]
 fn range_sweep<P: PassKind>(

@@ -36,12 +36,8 @@ impl RangePlan {
     /// vary from step to step (a median 3 %, 13 % at the 90th percentile), so the two threads finish phase B on
     /// average 10 % of the phase apart; small ranges at the back of each block let the thread that finishes first
     /// take over the other's last few percent. Equal ranges cannot do that: a range large enough to keep the
-    /// boundary pairs few is larger than the usual lead. Measured with two two-thread simulations interleaved in one
-    /// process with the one-thread reference (a probe of `bench dem --speedup`, 2026-12-03, 20,000 steps), time
-    /// against two equal ranges per thread: 0.970, 0.980, 0.962, 0.952 for [0.8, 0.12, 0.08]; 0.947, 0.992 for
-    /// [0.85, 0.1, 0.05]; 0.987 for [0.7, 0.2, 0.1]; 0.958 for [0.8, 0.1, 0.06, 0.04]; the same layout against
-    /// itself 0.987, 0.984, 1.017, 0.975. Earlier (2026-12-01, 2026-12-03), equal ranges: 2 per thread beat 4, 8
-    /// and 16 per thread, and 3 took 0.998 times as long as 2.
+    /// boundary pairs few is larger than the usual lead. This layout took 3-5 % less time than two equal ranges
+    /// per thread (the measurements: `docs/performance.md`, "The parallel pass's range layout").
     pub const BLOCK: [f64; 3] = [0.8, 0.12, 0.08];
 
     /// The cost shares of the ranges that `threads` threads work on: `block` (one thread's ranges, front to back)

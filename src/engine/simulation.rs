@@ -108,7 +108,7 @@ pub struct Simulation {
 
     // What this process measured.
     pub timers: StageTimers,
-    /// Events of the cohesion passes since the start of this process.
+    /// Cohesion events (bridges formed and broken, well crossings) since the start of this process.
     pub cohesion_events: CohesionEvents,
     /// Liquid sprayed since the start of this process, m³ (the state keeps it per particle).
     pub sprayed_m3: f64,
@@ -651,14 +651,10 @@ impl Simulation {
     /// Elastic energy stored in the active contacts, J: (8/15) E* √R* δ^{5/2} for Hertzian contacts that have not
     /// yielded, ½ K δ² for the linear spring. Tangential springs are not counted (zero for frictionless runs).
     pub fn elastic_energy_j(&self) -> f64 {
-        use super::models::NormalModel;
         let c = &self.config;
         let p = &self.particles;
-        let potential = |mat: &super::models::PairMaterial, r_star: f64, overlap: f64| match c.contact_law.normal {
-            NormalModel::LinearSpringDashpot { stiffness_n_per_m, .. } => 0.5 * stiffness_n_per_m * overlap * overlap,
-            NormalModel::Hertz { .. } | NormalModel::Thornton { .. } => {
-                8.0 / 15.0 * mat.effective_youngs_modulus_pa * r_star.sqrt() * overlap.powf(2.5)
-            }
+        let potential = |mat: &super::models::PairMaterial, r_star: f64, overlap: f64| {
+            c.contact_law.normal.elastic_energy_j(mat, r_star, overlap)
         };
         let mut e = 0.0;
         for i in 0..p.len() {

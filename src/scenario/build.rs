@@ -349,30 +349,9 @@ fn engine_gravity(g: &GravitySpec) -> Gravity {
 }
 
 fn check_contact_law(c: &Checker, law: &ContactLaw) -> Result<(), ConfigError> {
-    match law.normal {
-        NormalModel::LinearSpringDashpot {
-            stiffness_n_per_m,
-            damping_kg_per_s,
-        } => {
-            c.positive(
-                "contact.normal.linear_spring_dashpot.stiffness_n_per_m",
-                stiffness_n_per_m,
-            )?;
-            c.non_negative(
-                "contact.normal.linear_spring_dashpot.damping_kg_per_s",
-                damping_kg_per_s,
-            )?;
-        }
-        NormalModel::Hertz { restitution } => {
-            if !(restitution.is_finite() && restitution > 0.0 && restitution <= 1.0) {
-                return Err(c.fail(
-                    "contact.normal.hertz.restitution",
-                    format!("expected 0 < e <= 1, got {restitution}"),
-                ));
-            }
-        }
-        NormalModel::Thornton { .. } => {}
-    }
+    law.normal
+        .check()
+        .map_err(|(key, message)| c.fail(format!("contact.normal.{key}"), message))?;
     let hertzian = !matches!(law.normal, NormalModel::LinearSpringDashpot { .. });
     match law.tangential {
         TangentialModel::LinearSpringCoulomb {

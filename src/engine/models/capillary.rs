@@ -11,7 +11,7 @@
 //!
 //! Not settled: the fit's θ² term raises the force with the contact angle for V̂ < 0.06, while the exact bridge
 //! weakens with it (seed 000's printed B; see `young_laplace.rs`): at θ = 20°/40° it is 7–160 % above the exact
-//! bridge, and with the term's sign flipped still 12–46 % off at V̂ = 1e-3 and 5e-2. The cohesion pass therefore
+//! bridge, and with the term's sign flipped still 12–46 % off at V̂ = 1e-3 and 5e-2. The pair pass therefore
 //! uses Mikami only between equal particles at θ = 0 and the Young–Laplace table (`capillary_table.rs`) otherwise.
 
 use std::f64::consts::PI;

@@ -1,5 +1,5 @@
 //! The Young–Laplace force tables on disk: built at first use and cached, so that only the first job of a campaign
-//! pays the 1–3 s per unlike species pair (issue 5: "generated at first use and cached").
+//! pays the 1–3 s per unlike species pair (and per particle–wall species pair).
 //!
 //! A table in dimensionless form depends only on R₂/R₁, θ₁ and θ₂ (and on the solver and its grid), so the file
 //! is named by a hash of their bit patterns and of [`FORMAT`]. The file holds the rows' f64 bit patterns followed by

@@ -2,7 +2,7 @@
 //! composes them for a single contact.
 //!
 //! The composition passes values explicitly: the normal slot's force and contact radius go to the tangential and
-//! rolling slots. Lever arms and torques are formed by the caller (`forces.rs`), which also owns the geometry.
+//! rolling slots. Lever arms and torques are formed by the caller (`pair_pass.rs`), which also owns the geometry.
 
 use serde::{Deserialize, Serialize};
 
@@ -41,9 +41,19 @@ pub struct ContactKinematics {
     pub relative_angular_velocity: Vec3,
 }
 
-/// What one contact exerts on particle i (the partner receives the opposite force).
+/// One contact's result: its geometry and what it exerts on particle i (the partner receives the opposite force).
+/// The geometry is what a contact's heat or liquid transfer needs beside the force; the pass reads the fields it
+/// uses and the compiler drops the others.
 #[derive(Debug, Clone, Copy)]
 pub struct ContactOutput {
+    /// Unit normal from the partner to i.
+    pub normal: Vec3,
+    /// Overlap δ, m.
+    pub overlap_m: f64,
+    /// Contact radius a, m: √(R* δ) for the Hertzian normal models, 0 for the linear spring (no contact area).
+    pub contact_radius_m: f64,
+    /// Normal force on i along `normal`, N.
+    pub normal_force_n: f64,
     /// Total contact force on i.
     pub force: Vec3,
     /// Its tangential part, for the torques −R n × F_t.
@@ -64,8 +74,7 @@ impl ContactLaw {
             tangential: true,
             walton_braun: matches!(self.tangential, TangentialModel::WaltonBraun { .. }),
             thornton: matches!(self.normal, NormalModel::Thornton { .. }),
-            cohesion: false,
-            contact_duration: false,
+            ..HistoryLayout::NONE
         }
     }
 
@@ -98,6 +107,10 @@ impl ContactLaw {
         );
         hist.active = true;
         ContactOutput {
+            normal: n,
+            overlap_m: k.overlap_m,
+            contact_radius_m: normal.contact_radius_m,
+            normal_force_n: normal.force_n,
             force: n * normal.force_n + ft,
             tangential_force: ft,
             rolling_torque,

@@ -33,13 +33,25 @@ pub struct HistoryLayout {
     pub contact_duration: bool,
 }
 
+impl HistoryLayout {
+    /// No optional column: the base that layouts name their columns against (`..HistoryLayout::NONE`), so that a
+    /// new column's flag is written only where a run turns it on.
+    pub const NONE: HistoryLayout = HistoryLayout {
+        tangential: false,
+        walton_braun: false,
+        thornton: false,
+        cohesion: false,
+        contact_duration: false,
+    };
+}
+
 /// A history layout known at compile time: loads and stores of the fields it leaves out compile to nothing.
 pub trait StaticLayout {
     const LAYOUT: HistoryLayout;
 }
 
 /// The layouts of the contact pass: the contact law's columns (`WB`: Walton-Braun, `TH`: Thornton); the cohesion
-/// slot is left to the cohesion pass.
+/// slot is left to the cohesion kernels (`engine::cohesion`), which read and write it field by field.
 pub struct ContactLayout<const WB: bool, const TH: bool>;
 
 impl<const WB: bool, const TH: bool> StaticLayout for ContactLayout<WB, TH> {
@@ -47,8 +59,7 @@ impl<const WB: bool, const TH: bool> StaticLayout for ContactLayout<WB, TH> {
         tangential: true,
         walton_braun: WB,
         thornton: TH,
-        cohesion: false,
-        contact_duration: false,
+        ..HistoryLayout::NONE
     };
 }
 

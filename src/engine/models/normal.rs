@@ -56,6 +56,46 @@ pub struct NormalOutput {
 }
 
 impl NormalModel {
+    /// Checks the law's own parameters: `Err((key under contact.normal, what was expected))`.
+    pub fn check(&self) -> Result<(), (&'static str, String)> {
+        let positive = |key, v: f64| {
+            (v.is_finite() && v > 0.0)
+                .then_some(())
+                .ok_or((key, format!("expected a finite value > 0, got {v}")))
+        };
+        let non_negative = |key, v: f64| {
+            (v.is_finite() && v >= 0.0)
+                .then_some(())
+                .ok_or((key, format!("expected a finite value >= 0, got {v}")))
+        };
+        match *self {
+            NormalModel::LinearSpringDashpot {
+                stiffness_n_per_m,
+                damping_kg_per_s,
+            } => {
+                positive("linear_spring_dashpot.stiffness_n_per_m", stiffness_n_per_m)?;
+                non_negative("linear_spring_dashpot.damping_kg_per_s", damping_kg_per_s)
+            }
+            NormalModel::Hertz { restitution } => (restitution.is_finite() && restitution > 0.0 && restitution <= 1.0)
+                .then_some(())
+                .ok_or(("hertz.restitution", format!("expected 0 < e <= 1, got {restitution}"))),
+            NormalModel::Thornton { .. } => Ok(()),
+        }
+    }
+
+    /// The elastic energy stored in a contact of overlap δ (the work of the elastic force from 0 to δ), J: ½kδ² for
+    /// the linear spring, (8/15) E* √R* δ^{5/2} for the Hertzian laws (Thornton's plastic part not counted).
+    pub fn elastic_energy_j(&self, mat: &PairMaterial, effective_radius_m: f64, overlap_m: f64) -> f64 {
+        match *self {
+            NormalModel::LinearSpringDashpot { stiffness_n_per_m, .. } => {
+                0.5 * stiffness_n_per_m * overlap_m * overlap_m
+            }
+            NormalModel::Hertz { .. } | NormalModel::Thornton { .. } => {
+                8.0 / 15.0 * mat.effective_youngs_modulus_pa * effective_radius_m.sqrt() * overlap_m.powf(2.5)
+            }
+        }
+    }
+
     pub fn name(&self) -> &'static str {
         match self {
             NormalModel::LinearSpringDashpot { .. } => "linear_spring_dashpot",

@@ -1,7 +1,7 @@
 //! Material properties mixed once per species pair (E*, G*, μ, F_y, μ_r), looked up in the hot loop.
 //!
 //! Geometric mixing (R*, m*) depends on the two particles, not their species, and is done per contact in
-//! `forces.rs`. Walls are species too: a particle–wall pair uses the (particle species, wall species) entry.
+//! `pair_pass.rs`. Walls are species too: a particle–wall pair uses the (particle species, wall species) entry.
 
 use super::contact_law::ContactLaw;
 use super::normal::{NormalModel, SQRT_FIVE_SIXTHS, damping_beta};
