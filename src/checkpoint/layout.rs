@@ -647,6 +647,7 @@ impl Arrays {
                 mass_imbalance: self.gas_last_mass_imbalance[0],
                 converged: self.gas_last_converged[0] == 1,
             },
+            scalars: Vec::new(),
         });
         let net_force = (self.net_force_steps.len() == 1).then(|| NetForceTally {
             steps: self.net_force_steps[0],

@@ -556,6 +556,7 @@ mod tests {
                     mass_imbalance: 1.25e-9,
                     converged: true,
                 },
+                scalars: Vec::new(),
             }),
         }
     }

@@ -144,23 +144,25 @@ pub fn first_difference(a: &SimState, b: &SimState) -> Option<String> {
         return Some("gas: present in one state only".into());
     }
     if let (Some(g), Some(h)) = (&a.gas, &b.gas) {
+        let names = |s: &GasSnapshot| {
+            s.fields()
+                .map(|v| format!("{} ({})", v.name, v.unit))
+                .collect::<Vec<_>>()
+        };
         let gas = f("gas.time_s", g.time_s, h.time_s)
-            .or_else(|| scalars("gas.pressure_pa", &g.pressure_pa, &h.pressure_pa))
-            .or_else(|| scalars("gas.porosity", &g.porosity, &h.porosity))
+            .or_else(|| (names(g) != names(h)).then(|| format!("gas fields: {:?} vs {:?}", names(g), names(h))))
+            .or_else(|| {
+                g.fields()
+                    .zip(h.fields())
+                    .find_map(|(x, y)| scalars(&format!("gas.{}", x.name), x.values, y.values))
+            })
             .or_else(|| {
                 (0..3).find_map(|k| {
                     scalars(
-                        &format!("gas.velocity_m_per_s[{k}]"),
-                        &g.velocity_m_per_s[k],
-                        &h.velocity_m_per_s[k],
+                        &format!("gas.reaction_n_per_m3[{k}]"),
+                        &g.reaction_n_per_m3[k],
+                        &h.reaction_n_per_m3[k],
                     )
-                    .or_else(|| {
-                        scalars(
-                            &format!("gas.reaction_n_per_m3[{k}]"),
-                            &g.reaction_n_per_m3[k],
-                            &h.reaction_n_per_m3[k],
-                        )
-                    })
                     .or_else(|| scalars(&format!("gas.beta_sum[{k}]"), &g.beta_sum[k], &h.beta_sum[k]))
                     .or_else(|| {
                         scalars(
@@ -171,7 +173,23 @@ pub fn first_difference(a: &SimState, b: &SimState) -> Option<String> {
                     })
                 })
             })
-            .or_else(|| (g.reaction_steps != h.reaction_steps).then(|| "gas.reaction_steps".to_string()));
+            .or_else(|| (g.reaction_steps != h.reaction_steps).then(|| "gas.reaction_steps".to_string()))
+            .or_else(|| {
+                g.scalars.iter().zip(&h.scalars).find_map(|(x, y)| {
+                    let (p, q) = (&x.exchange, &y.exchange);
+                    let name = |sum: &str| format!("gas.{}.exchange.{sum}", x.name);
+                    scalars(&name("coefficient_sum"), &p.coefficient_sum, &q.coefficient_sum)
+                        .or_else(|| {
+                            scalars(
+                                &name("coefficient_value_sum"),
+                                &p.coefficient_value_sum,
+                                &q.coefficient_value_sum,
+                            )
+                        })
+                        .or_else(|| scalars(&name("transfer_sum"), &p.transfer_sum, &q.transfer_sum))
+                        .or_else(|| (p.steps != q.steps).then(|| name("steps")))
+                })
+            });
         if gas.is_some() {
             return gas;
         }

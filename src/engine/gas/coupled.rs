@@ -4,13 +4,20 @@
 //! sub-steps (CHOICE: averaged rather than the last sub-step's, so the momentum the gas receives over a gas step is
 //! exactly what the particles lost to drag over it).
 //!
+//! After the momentum and pressure solve, each transported scalar (none unless declared with
+//! [`GasCoupling::declare_scalar`]) takes the same step with the new mass flows and porosity and its particle
+//! exchange averaged over the same sub-steps ([`super::transported_scalar`]).
+//!
 //! A [`GasCoupling`] lives inside a [`crate::engine::Simulation`], which calls [`GasCoupling::advance`] after every
 //! `dem_steps_per_gas_step`-th step; its state ([`GasSnapshot`]) is part of the checkpoint.
 
 use super::coupling::{PorosityMethod, porosity};
+use super::exchange_accumulator::ExchangeAccumulator;
+use super::field::{FieldLocation, GasField, GasFieldView};
 use super::fluid_forces::{DragCoupling, DragVelocities, FluidForces};
 use super::grid::{Boundary, side};
 use super::simple::{GasConfig, GasSolver};
+use super::transported_scalar::{GasScalarSpec, TransportedScalar};
 use crate::engine::Vec3;
 use crate::engine::models::drag::DragLaw;
 
@@ -42,7 +49,40 @@ pub struct GasSnapshot {
     pub beta_velocity_sum: [Vec<f64>; 3],
     pub reaction_steps: u32,
     pub last: GasStepStats,
+    /// The transported scalars in their declaration order; empty when none is declared (the checkpoint then has
+    /// nothing more to hold).
+    pub scalars: Vec<GasScalarSnapshot>,
 }
+
+/// A transported scalar's checkpointed state: its field and the exchange accumulated since the last gas step.
+#[derive(Debug, Clone, PartialEq)]
+pub struct GasScalarSnapshot {
+    /// The spec's name (`temperature_k`): a restore matches scalars by it.
+    pub name: String,
+    pub unit: String,
+    /// φ at the cell centres.
+    pub value: Vec<f64>,
+    pub exchange: ExchangeAccumulator,
+}
+
+impl GasSnapshot {
+    /// Every field of the state with its name and unit: those of [`GasField::ALL`], then the transported scalars.
+    pub fn fields(&self) -> impl Iterator<Item = GasFieldView<'_>> {
+        GasField::ALL
+            .into_iter()
+            .map(|f| f.view(&self.pressure_pa, &self.velocity_m_per_s, &self.porosity))
+            .chain(self.scalars.iter().map(|s| GasFieldView {
+                name: &s.name,
+                unit: &s.unit,
+                location: FieldLocation::Cells,
+                values: &s.value,
+            }))
+    }
+}
+
+/// Names a transported scalar of a [`GasCoupling`] (its place in declaration order).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct GasScalarId(usize);
 
 pub struct GasCoupling {
     pub solver: GasSolver,
@@ -58,6 +98,8 @@ pub struct GasCoupling {
     pub last: GasStepStats,
     /// Wall time spent in the gas's linear solvers (not checkpointed; for profiles), s.
     pub linear_solve_s: f64,
+    /// The transported scalars, in declaration order.
+    scalars: Vec<TransportedScalar>,
 }
 
 impl GasCoupling {
@@ -101,7 +143,36 @@ impl GasCoupling {
             gas_body_force_n_per_m3: [0.0; 3],
             last: GasStepStats::default(),
             linear_solve_s: 0.0,
+            scalars: Vec::new(),
         })
+    }
+
+    /// Adds a scalar carried by the gas from now on, at its initial value everywhere. Names must be unique.
+    pub fn declare_scalar(&mut self, spec: GasScalarSpec) -> Result<GasScalarId, String> {
+        if self.scalars.iter().any(|s| s.spec.name == spec.name) {
+            return Err(format!("transported scalar {}: declared twice", spec.name));
+        }
+        self.scalars.push(TransportedScalar::new(spec, &self.solver)?);
+        Ok(GasScalarId(self.scalars.len() - 1))
+    }
+
+    /// The transported scalars, in declaration order.
+    pub fn scalars(&self) -> &[TransportedScalar] {
+        &self.scalars
+    }
+
+    pub fn scalar(&self, id: GasScalarId) -> &TransportedScalar {
+        &self.scalars[id.0]
+    }
+
+    /// The scalar `id`, to set its field or add to its exchange accumulator.
+    pub fn scalar_mut(&mut self, id: GasScalarId) -> &mut TransportedScalar {
+        &mut self.scalars[id.0]
+    }
+
+    /// The scalar named `name`.
+    pub fn scalar_named(&self, name: &str) -> Option<GasScalarId> {
+        self.scalars.iter().position(|s| s.spec.name == name).map(GasScalarId)
     }
 
     /// One gas step of `dt_s` after the DEM sub-steps: new porosity from `positions_m`, the mean drag reaction as
@@ -167,6 +238,15 @@ impl GasCoupling {
         if let Some(what) = self.non_finite() {
             return Err(what);
         }
+        if !self.scalars.is_empty() {
+            let mass_flow = self.solver.mass_flow_kg_per_s();
+            for scalar in &mut self.scalars {
+                let t = std::time::Instant::now();
+                let r = scalar.step(&self.solver, &old_porosity, &mass_flow, dt_s)?;
+                self.linear_solve_s += t.elapsed().as_secs_f64();
+                linear_iterations += r.iterations as u64;
+            }
+        }
         let state = &self.solver.state;
         self.fluid.freeze(
             &self.solver.interstitial_velocity_m_per_s(),
@@ -182,18 +262,16 @@ impl GasCoupling {
         Ok(self.last)
     }
 
-    /// Names the first non-finite gas quantity, if any.
+    /// Names the first non-finite field of the gas solver's state, if any.
     fn non_finite(&self) -> Option<String> {
-        let state = &self.solver.state;
-        if let Some(k) = state.pressure_pa.iter().position(|p| !p.is_finite()) {
-            return Some(format!("gas pressure of cell {k} is not finite"));
-        }
-        for (a, v) in state.velocity_m_per_s.iter().enumerate() {
-            if let Some(k) = v.iter().position(|u| !u.is_finite()) {
-                return Some(format!("gas velocity component {a} of face {k} is not finite"));
-            }
-        }
-        None
+        self.solver.state.fields().find_map(|field| {
+            let k = field.values.iter().position(|v| !v.is_finite())?;
+            let at = match field.location {
+                FieldLocation::Cells => "cell",
+                FieldLocation::Faces { .. } => "face",
+            };
+            Some(format!("gas {} of {at} {k} is not finite", field.name))
+        })
     }
 
     pub fn snapshot(&self) -> GasSnapshot {
@@ -203,38 +281,70 @@ impl GasCoupling {
             velocity_m_per_s: s.velocity_m_per_s.clone(),
             porosity: s.porosity.clone(),
             time_s: s.time_s,
-            reaction_n_per_m3: self.fluid.reaction_n_per_m3.clone(),
-            beta_sum: self.fluid.beta_sum.clone(),
-            beta_velocity_sum: self.fluid.beta_velocity_sum.clone(),
-            reaction_steps: self.fluid.steps,
+            reaction_n_per_m3: std::array::from_fn(|a| self.fluid.momentum_exchange[a].transfer_sum.clone()),
+            beta_sum: std::array::from_fn(|a| self.fluid.momentum_exchange[a].coefficient_sum.clone()),
+            beta_velocity_sum: std::array::from_fn(|a| self.fluid.momentum_exchange[a].coefficient_value_sum.clone()),
+            reaction_steps: self.fluid.steps(),
             last: self.last,
+            scalars: self
+                .scalars
+                .iter()
+                .map(|s| GasScalarSnapshot {
+                    name: s.spec.name.to_string(),
+                    unit: s.spec.unit.to_string(),
+                    value: s.value.clone(),
+                    exchange: s.exchange.clone(),
+                })
+                .collect(),
         }
     }
 
     /// Puts a checkpointed gas state back (the grid must match: checked by the checkpoint reader's shapes and
-    /// here against the solver's).
+    /// here against the solver's; the transported scalars must be those declared, by name and in order).
     pub fn restore(&mut self, snap: &GasSnapshot) -> Result<(), String> {
         let grid = &self.solver.config.grid;
-        if snap.pressure_pa.len() != grid.cells() || snap.porosity.len() != grid.cells() {
+        let declared: Vec<&str> = self.scalars.iter().map(|s| s.spec.name).collect();
+        let stored: Vec<&str> = snap.scalars.iter().map(|s| s.name.as_str()).collect();
+        if declared != stored {
             return Err(format!(
-                "the checkpoint's gas has {} cells, the scenario's grid {}",
-                snap.pressure_pa.len(),
-                grid.cells()
+                "the checkpoint's gas carries the scalars {stored:?}, the scenario's {declared:?}"
             ));
+        }
+        for field in snap.fields() {
+            let expected = field.location.len(grid);
+            if field.values.len() != expected {
+                return Err(format!(
+                    "the checkpoint's gas {} has {} values, the scenario's grid {expected}",
+                    field.name,
+                    field.values.len()
+                ));
+            }
         }
         for a in 0..3 {
             let n = grid.faces(a);
-            if snap.velocity_m_per_s[a].len() != n
-                || snap.reaction_n_per_m3[a].len() != n
+            if snap.reaction_n_per_m3[a].len() != n
                 || snap.beta_sum[a].len() != n
                 || snap.beta_velocity_sum[a].len() != n
             {
                 return Err(format!(
-                    "the checkpoint's gas has {} faces along axis {a}, the scenario's grid {}",
-                    snap.velocity_m_per_s[a].len(),
-                    grid.faces(a)
+                    "the checkpoint's gas drag sums have {} faces along axis {a}, the scenario's grid {n}",
+                    snap.reaction_n_per_m3[a].len(),
                 ));
             }
+        }
+        for (scalar, stored) in self.scalars.iter_mut().zip(&snap.scalars) {
+            if stored.unit != scalar.spec.unit {
+                return Err(format!(
+                    "the checkpoint's gas scalar {} is in {}, the scenario's in {}",
+                    stored.name, stored.unit, scalar.spec.unit
+                ));
+            }
+            let e = &stored.exchange;
+            scalar
+                .exchange
+                .restore(&e.coefficient_sum, &e.coefficient_value_sum, &e.transfer_sum, e.steps)
+                .map_err(|err| format!("the checkpoint's gas scalar {}: {err}", stored.name))?;
+            scalar.value.clone_from(&stored.value);
         }
         let s = &mut self.solver.state;
         s.pressure_pa.clone_from(&snap.pressure_pa);
@@ -244,10 +354,14 @@ impl GasCoupling {
         let u = self.solver.interstitial_velocity_m_per_s();
         let s = &self.solver.state;
         self.fluid.freeze(&u, &s.pressure_pa, &s.porosity);
-        self.fluid.reaction_n_per_m3.clone_from(&snap.reaction_n_per_m3);
-        self.fluid.beta_sum.clone_from(&snap.beta_sum);
-        self.fluid.beta_velocity_sum.clone_from(&snap.beta_velocity_sum);
-        self.fluid.steps = snap.reaction_steps;
+        for (a, exchange) in self.fluid.momentum_exchange.iter_mut().enumerate() {
+            exchange.restore(
+                &snap.beta_sum[a],
+                &snap.beta_velocity_sum[a],
+                &snap.reaction_n_per_m3[a],
+                snap.reaction_steps,
+            )?;
+        }
         self.last = snap.last;
         Ok(())
     }

@@ -16,6 +16,7 @@ use std::f64::consts::PI;
 use serde::{Deserialize, Serialize};
 
 use super::coupling::FaceLattice;
+use super::exchange_accumulator::ExchangeAccumulator;
 use super::grid::Grid;
 use crate::engine::Vec3;
 use crate::engine::models::drag::{DragInput, DragLaw};
@@ -88,14 +89,11 @@ pub struct FluidForces {
     /// −∂p/∂x_a on the faces of component a, Pa/m.
     pub minus_pressure_gradient_pa_per_m: [Vec<f64>; 3],
     pub porosity: Vec<f64>,
-    /// Σ over DEM steps of the force on the gas per unit volume at each face, N/m³ (divide by `steps`).
-    pub reaction_n_per_m3: [Vec<f64>; 3],
-    /// Σ over DEM steps of w K / V_cell at each face, N·s/m⁴: the exchange coefficient β the semi-implicit
-    /// coupling puts into the gas momentum equation as −β u.
-    pub beta_sum: [Vec<f64>; 3],
-    /// Σ over DEM steps of w K v / V_cell at each face (v the particle velocity the drag used), N/m³: its +β v.
-    pub beta_velocity_sum: [Vec<f64>; 3],
-    pub steps: u32,
+    /// The momentum exchange since the freeze, one accumulator per velocity component over its faces: the
+    /// transfer is the force on the gas per unit volume, N/m³ (the reaction to drag); the coefficient is w K /
+    /// V_cell, N·s/m⁴ (the β the semi-implicit coupling puts into the gas momentum equation as −β u); the
+    /// coefficient-value sum is w K v / V_cell, N/m³ (its +β v, v the particle velocity the drag used).
+    pub momentum_exchange: [ExchangeAccumulator; 3],
     /// The trilinear lattices of the three velocity components (built from `grid`).
     lattice: [FaceLattice; 3],
     inverse_h_per_m: [f64; 3],
@@ -127,11 +125,8 @@ impl FluidForces {
         FluidForces {
             velocity_m_per_s: zeros(&grid),
             minus_pressure_gradient_pa_per_m: zeros(&grid),
-            reaction_n_per_m3: zeros(&grid),
-            beta_sum: zeros(&grid),
-            beta_velocity_sum: zeros(&grid),
+            momentum_exchange: std::array::from_fn(|a| ExchangeAccumulator::new(grid.faces(a))),
             porosity: vec![1.0; grid.cells()],
-            steps: 0,
             lattice: std::array::from_fn(|a| FaceLattice::new(&grid, a)),
             inverse_h_per_m: std::array::from_fn(|a| 1.0 / grid.h_m[a]),
             periodic: std::array::from_fn(|a| grid.periodic(a)),
@@ -176,15 +171,7 @@ impl FluidForces {
             }
         }
         self.porosity.copy_from_slice(porosity);
-        for r in self
-            .reaction_n_per_m3
-            .iter_mut()
-            .chain(self.beta_sum.iter_mut())
-            .chain(self.beta_velocity_sum.iter_mut())
-        {
-            r.iter_mut().for_each(|v| *v = 0.0);
-        }
-        self.steps = 0;
+        self.momentum_exchange.iter_mut().for_each(ExchangeAccumulator::clear);
     }
 
     /// The cell holding `x` (clamped into a non-periodic grid, wrapped on a periodic axis), as a flat index.
@@ -255,7 +242,9 @@ impl FluidForces {
                 self.add_forces_cell_averaged(positions_m, velocities_m_per_s, radii_m, force, team)
             }
         }
-        self.steps += 1;
+        self.momentum_exchange
+            .iter_mut()
+            .for_each(ExchangeAccumulator::end_sub_step);
     }
 
     /// −∇p interpolated to `x`.
@@ -338,10 +327,12 @@ impl FluidForces {
             let (d, k, v_sm) = (ws.drag_sum_n[c], ws.k_sum_n_s_per_m[c], ws.momentum[c]);
             let idx = self.cell_indices(c);
             for a in 0..self.grid.axes() {
-                for face in self.cell_faces(idx, a) {
-                    self.reaction_n_per_m3[a][face] -= half_per_volume * d[a];
-                    self.beta_sum[a][face] += half_per_volume * k;
-                    self.beta_velocity_sum[a][face] += half_per_volume * k * v_sm[a];
+                let faces = self.cell_faces(idx, a);
+                let exchange = &mut self.momentum_exchange[a];
+                for face in faces {
+                    // x + (−y) is x − y to the bit (IEEE 754 subtraction is addition of the negation).
+                    exchange.add_transfer(face, -(half_per_volume * d[a]));
+                    exchange.add_exchange(face, half_per_volume * k, v_sm[a]);
                 }
             }
             ws.solid_volume_m3[c] = 0.0;
@@ -407,16 +398,11 @@ impl FluidForces {
         for (x, (d, k, v)) in positions_m.iter().zip(&drag) {
             for a in 0..self.grid.axes() {
                 let stencil = self.lattice[a].stencil(x);
-                let (reaction, beta, beta_v) = (
-                    &mut self.reaction_n_per_m3[a],
-                    &mut self.beta_sum[a],
-                    &mut self.beta_velocity_sum[a],
-                );
+                let exchange = &mut self.momentum_exchange[a];
                 for c in 0..stencil.count {
                     let (face, w) = (stencil.face[c], stencil.weight[c] * per_volume);
-                    reaction[face] -= w * d[a];
-                    beta[face] += w * k;
-                    beta_v[face] += w * k * v[a];
+                    exchange.add_transfer(face, -(w * d[a]));
+                    exchange.add_exchange(face, w * k, v[a]);
                 }
             }
         }
@@ -425,20 +411,20 @@ impl FluidForces {
 
     /// The mean reaction per unit volume over the DEM steps since the last freeze (the gas's momentum source).
     pub fn mean_reaction(&self) -> [Vec<f64>; 3] {
-        Self::mean(&self.reaction_n_per_m3, self.steps)
+        std::array::from_fn(|a| self.momentum_exchange[a].mean_transfer())
     }
 
     /// The semi-implicit form of the same exchange: (β, β v) per face, averaged over the DEM steps since the last
     /// freeze; the gas then feels −β u_new + β v.
     pub fn mean_exchange(&self) -> ([Vec<f64>; 3], [Vec<f64>; 3]) {
         (
-            Self::mean(&self.beta_sum, self.steps),
-            Self::mean(&self.beta_velocity_sum, self.steps),
+            std::array::from_fn(|a| self.momentum_exchange[a].mean_coefficient()),
+            std::array::from_fn(|a| self.momentum_exchange[a].mean_coefficient_value()),
         )
     }
 
-    fn mean(sum: &[Vec<f64>; 3], steps: u32) -> [Vec<f64>; 3] {
-        let n = f64::from(steps.max(1));
-        std::array::from_fn(|a| sum[a].iter().map(|v| v / n).collect())
+    /// DEM sub-steps accumulated since the last freeze.
+    pub fn steps(&self) -> u32 {
+        self.momentum_exchange[0].steps
     }
 }

@@ -1,0 +1,194 @@
+//! Scalars carried by the gas (its temperature, a vapour concentration), each declared by name and unit with its
+//! diffusivity and the values the boundaries give it ([`GasScalarSpec`]), and held as a field with its particle
+//! exchange accumulator ([`TransportedScalar`]). A gas step moves each one with the step's new mass flows and
+//! porosity ([`TransportedScalar::step`], through [`super::scalar::ScalarEquation`]):
+//! - gas entering through an inlet side carries the inlet value, through a jet the jet's value;
+//! - gas leaving through an outlet carries the cell's value (zero gradient), and so does gas flowing back in;
+//! - a wall passes no flux, or holds the scalar at a value when the spec says so;
+//! - blocked cells are outside the gas: nothing crosses their faces, they keep their value (CHOICE: adiabatic;
+//!   conduction through a kiln wall is a model of its own);
+//! - the particles exchange K (φ_p − φ) per unit volume, implicitly, from the means of the accumulator.
+//!
+//! What fills the accumulator (a heat-transfer law, evaporation) is not here.
+
+use super::exchange_accumulator::ExchangeAccumulator;
+use super::grid::{Boundary, side};
+use super::linsolve::SolveReport;
+use super::scalar::ScalarEquation;
+use super::simple::{GasSolver, face_index};
+
+/// A scalar's condition on a wall side.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum ScalarWall {
+    /// No flux through the wall.
+    ZeroFlux,
+    /// The scalar held at `value` on the wall (diffusion over the half cell next to it).
+    Fixed { value: f64 },
+}
+
+/// A transported scalar's declaration.
+#[derive(Debug, Clone, PartialEq)]
+pub struct GasScalarSpec {
+    /// The field's name with its unit suffix (`temperature_k`): views, errors and checkpoints use it.
+    pub name: &'static str,
+    /// The unit of φ (`K`, `kg/kg`).
+    pub unit: &'static str,
+    /// ρ × diffusivity, kg/(m·s) (for heat: the gas conductivity over its specific heat).
+    pub diffusion_kg_per_m_s: f64,
+    /// φ everywhere at the start.
+    pub initial_value: f64,
+    /// φ of the gas entering through inlet sides, and through jets without a value of their own.
+    pub inlet_value: f64,
+    /// φ of the gas entering through each jet, in the order of `GasConfig::inlet_faces`; empty: every jet at
+    /// `inlet_value`.
+    pub jet_values: Vec<f64>,
+    /// The condition on each side (`grid::side` order) that is a wall; must be `ZeroFlux` on the other sides.
+    pub walls: [ScalarWall; 6],
+}
+
+impl GasScalarSpec {
+    /// Checks the declaration against the gas it is carried by.
+    pub fn check(&self, solver: &GasSolver) -> Result<(), String> {
+        let name = self.name;
+        if name.is_empty() {
+            return Err("transported scalar: expected a name".into());
+        }
+        if !(self.diffusion_kg_per_m_s.is_finite() && self.diffusion_kg_per_m_s >= 0.0) {
+            return Err(format!(
+                "transported scalar {name}: diffusion_kg_per_m_s: expected ≥ 0, got {}",
+                self.diffusion_kg_per_m_s
+            ));
+        }
+        let jets = solver.config.inlet_faces.len();
+        if !self.jet_values.is_empty() && self.jet_values.len() != jets {
+            return Err(format!(
+                "transported scalar {name}: jet_values: expected one per jet ({jets}) or none, got {}",
+                self.jet_values.len()
+            ));
+        }
+        let values = [self.initial_value, self.inlet_value]
+            .into_iter()
+            .chain(self.jet_values.iter().copied());
+        if let Some(v) = values.into_iter().find(|v| !v.is_finite()) {
+            return Err(format!("transported scalar {name}: value {v} is not finite"));
+        }
+        let grid = &solver.config.grid;
+        for (s, wall) in self.walls.iter().enumerate() {
+            if let ScalarWall::Fixed { value } = wall {
+                if !matches!(grid.boundary[s], Boundary::Wall { .. }) || (s >= 4 && grid.two_d()) {
+                    return Err(format!(
+                        "transported scalar {name}: side {s} holds a wall value but is not a wall of the grid"
+                    ));
+                }
+                if !value.is_finite() {
+                    return Err(format!("transported scalar {name}: wall value {value} is not finite"));
+                }
+            }
+        }
+        Ok(())
+    }
+}
+
+/// A transported scalar's field and what the particles exchanged with it since the last gas step.
+#[derive(Debug, Clone, PartialEq)]
+pub struct TransportedScalar {
+    pub spec: GasScalarSpec,
+    /// φ at the cell centres, in `spec.unit`.
+    pub value: Vec<f64>,
+    /// Per cell: the exchange coefficient K per unit volume, kg/(m³·s), with the particle value φ_p it pulls
+    /// towards; the gas step takes K (φ_p − φ) implicitly from the means over the sub-steps.
+    pub exchange: ExchangeAccumulator,
+}
+
+impl TransportedScalar {
+    /// The scalar at its initial value over `solver`'s grid, after checking the spec.
+    pub fn new(spec: GasScalarSpec, solver: &GasSolver) -> Result<Self, String> {
+        spec.check(solver)?;
+        let cells = solver.config.grid.cells();
+        Ok(TransportedScalar {
+            value: vec![spec.initial_value; cells],
+            exchange: ExchangeAccumulator::new(cells),
+            spec,
+        })
+    }
+
+    /// φ on each boundary face where the boundary gives it (inlets, jets, walls held at a value); `None` for zero
+    /// gradient (outlets, walls without flux, faces of blocked cells).
+    pub fn boundary_values(&self, solver: &GasSolver) -> [Vec<Option<f64>>; 3] {
+        let grid = &solver.config.grid;
+        let mut values: [Vec<Option<f64>>; 3] = std::array::from_fn(|a| vec![None; grid.faces(a)]);
+        for (a, values) in values.iter_mut().enumerate().take(grid.axes()) {
+            if grid.periodic(a) {
+                continue;
+            }
+            for (f, value) in values.iter_mut().enumerate() {
+                let idx = face_index(grid, a, f);
+                let along = idx[a];
+                if (along != 0 && along != grid.n[a])
+                    || super::simple::face_touches_blocked(grid, &solver.config.blocked, a, idx)
+                {
+                    continue;
+                }
+                let s = side(a, along == grid.n[a]);
+                *value = match (grid.boundary[s], self.spec.walls[s]) {
+                    (Boundary::Inlet { .. }, _) => Some(self.spec.inlet_value),
+                    (Boundary::Wall { .. }, ScalarWall::Fixed { value }) => Some(value),
+                    _ => None,
+                };
+            }
+        }
+        for (k, jet) in solver.config.inlet_faces.iter().enumerate() {
+            let idx = face_index(grid, jet.axis, jet.face);
+            if !super::simple::face_touches_blocked(grid, &solver.config.blocked, jet.axis, idx) {
+                values[jet.axis][jet.face] =
+                    Some(self.spec.jet_values.get(k).copied().unwrap_or(self.spec.inlet_value));
+            }
+        }
+        values
+    }
+
+    /// Advances φ over the gas step of `dt_s` that `solver` has just taken from porosity `old_porosity`, with the
+    /// mean particle exchange of the accumulator (which is then cleared for the next sub-steps). Returns the
+    /// linear solve's report, or an error naming the field when the solve fails or φ stops being finite.
+    pub fn step(
+        &mut self,
+        solver: &GasSolver,
+        old_porosity: &[f64],
+        mass_flow_kg_per_s: &[Vec<f64>; 3],
+        dt_s: f64,
+    ) -> Result<SolveReport, String> {
+        let config = &solver.config;
+        let boundary_value = self.boundary_values(solver);
+        let (coefficient, coefficient_value) =
+            (self.exchange.mean_coefficient(), self.exchange.mean_coefficient_value());
+        let equation = ScalarEquation {
+            grid: &config.grid,
+            convection: config.convection,
+            density_kg_per_m3: config.density_kg_per_m3,
+            diffusion_kg_per_m_s: self.spec.diffusion_kg_per_m_s,
+            mass_flow_kg_per_s,
+            porosity: &solver.state.porosity,
+            old_porosity,
+            boundary_value: &boundary_value,
+            blocked: &config.blocked,
+            source: &[],
+            exchange_coefficient: &coefficient,
+            exchange_coefficient_value: &coefficient_value,
+        };
+        let mut phi = self.value.clone();
+        let report = equation.step(&mut phi, dt_s, config.linear_tolerance, config.max_linear_iterations);
+        let name = self.spec.name;
+        if let Some(k) = phi.iter().position(|v| !v.is_finite()) {
+            return Err(format!("gas scalar {name} of cell {k} is not finite"));
+        }
+        if !report.converged {
+            return Err(format!(
+                "gas scalar {name}: the linear solve stopped at relative residual {:e} after {} iterations",
+                report.relative_residual, report.iterations
+            ));
+        }
+        self.value = phi;
+        self.exchange.clear();
+        Ok(report)
+    }
+}
