@@ -1146,9 +1146,26 @@ mod tests {
             ds(&mut b, &path("reversal_force_n"), &[m, 3], &reversal);
             let direction = vec(|x| x.tangential.increment_direction);
             ds(&mut b, &path("increment_direction"), &[m, 3], &direction);
+            ds(&mut b, &path("duration_s"), &[m], &scalar(|x| x.duration.duration_s));
             let volume = scalar(|x| x.cohesion.bridge_volume_m3);
             ds(&mut b, &path("bridge_volume_m3"), &[m], &volume);
             ds(&mut b, &path("in_well"), &[m], &flag(|x| x.cohesion.in_well));
+        }
+        // The channels, as the documentation lists them.
+        let c = &p.channels;
+        for (name, values) in [
+            ("contacts_ended", &c.contacts_ended),
+            ("contact_time_ended_s", &c.contact_time_ended_s),
+            ("wall_contacts_ended", &c.wall_contacts_ended),
+            ("wall_contact_time_ended_s", &c.wall_contact_time_ended_s),
+            ("wall_contact_time_s", &c.wall_contact_time_s),
+        ] {
+            ds(
+                &mut b,
+                &format!("particles/channels/{name}"),
+                &[n],
+                &f(values.iter().copied()),
+            );
         }
 
         assert_eq!(stored, xxhash_rust::xxh3::xxh3_64(&b));

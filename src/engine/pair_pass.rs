@@ -4,9 +4,9 @@
 //!
 //! A wall is a partner like a particle, of infinite radius and mass with its own motion: each slot of the neighbour
 //! list (pair or wall) runs the same kernels, the contact law's (`models::contact_law`) while the pair overlaps and
-//! the cohesion model's (`engine::cohesion`) while it is in range or carries a state. A slot's result carries its
-//! force, the torques on both particles and its channel flows (`PairResult`); the channels are summed beside the
-//! forces in the same order. A dry run that records no channels compiles to the contact loop alone (the narrow
+//! the cohesion model's (`engine::cohesion`) while it is in range or carries a state. A slot gives its force and
+//! the torques on both particles (`PairResult`) and its channel flows into i (`ScalarFlows`, j receiving them by the
+//! channel's rule); the channels are summed beside the forces in the same order. A dry run that records no channels compiles to the contact loop alone (the narrow
 //! [`Pass`]); cohesion and channels are the wide pass's, each checked per slot at run time.
 //!
 //! The order for particle p is: first its contacts as the *second* particle of a pair (ascending first particle),
@@ -74,7 +74,7 @@ pub struct PairBuffers {
     torque_on_j: Vec<Vec3>,
     /// The channels' flows into i (empty when the run records no channels).
     scalars_on_i: Vec<ScalarFlows>,
-    /// The pair exerted a force (it touched, or a cohesion force acted) or gave the channels something.
+    /// The pair exerted a force (it touched, or a cohesion force acted).
     acted: Vec<bool>,
 }
 
@@ -262,25 +262,13 @@ struct Context<'a> {
     channels: bool,
 }
 
-/// Result of one particle–particle slot: force on i, torques on i and j, and the channels' flows into i.
+/// Result of one particle–particle slot: force on i, torques on i and j. (Its channel flows into i go to an
+/// out-parameter, which the narrow pass never writes: a larger result kept the hot loop's registers busier.)
 #[derive(Clone, Copy)]
 struct PairResult {
     force: Vec3,
     torque_i: Vec3,
     torque_j: Vec3,
-    scalars: ScalarFlows,
-}
-
-impl PairResult {
-    /// No force, only channel flows.
-    fn flows_only(scalars: ScalarFlows) -> PairResult {
-        PairResult {
-            force: Vec3::zeros(),
-            torque_i: Vec3::zeros(),
-            torque_j: Vec3::zeros(),
-            scalars,
-        }
-    }
 }
 
 /// What the pair loop of particle i reads of i, loaded once per particle rather than once per candidate.
@@ -390,6 +378,7 @@ impl<'a> Context<'a> {
         slot: usize,
         worst: &mut WorstOverlap,
         crossings: &mut u64,
+        flows: &mut ScalarFlows,
     ) -> Option<PairResult> {
         let d = self.config.domain.separation(&bi.x, &vel.x(j));
         let dist2 = d.norm_squared();
@@ -401,24 +390,17 @@ impl<'a> Context<'a> {
             None
         };
         if dist2 >= reach * reach {
-            let ended = self.contact_ended::<P>(hist, k, false);
+            if let Some(ended) = self.contact_ended::<P>(hist, k, false) {
+                *flows = ended;
+            }
             hist.release_as::<P>(k);
             // Apart: the cohesion model alone, while in range or carrying a bridge or well.
-            let bond = cohesion.and_then(|c| {
-                let range = reach + c.range_m;
-                if dist2 >= range * range && cohesion_state(hist, k).is_empty() {
-                    return None;
-                }
-                Some(self.pair_bond(c, bi, j, vel, d, dist2, reach, hist, k, slot, crossings))
-            });
-            return match (bond, ended) {
-                (Some(bond), ended) => Some(PairResult {
-                    scalars: ended.unwrap_or(ScalarFlows::ZERO),
-                    ..bond
-                }),
-                (None, Some(ended)) => Some(PairResult::flows_only(ended)),
-                (None, None) => None,
-            };
+            let c = cohesion?;
+            let range = reach + c.range_m;
+            if dist2 >= range * range && cohesion_state(hist, k).is_empty() {
+                return None;
+            }
+            return Some(self.pair_bond(c, bi, j, vel, d, dist2, reach, hist, k, slot, crossings));
         }
         let dist = dist2.sqrt();
         let inv_dist = 1.0 / dist;
@@ -452,7 +434,6 @@ impl<'a> Context<'a> {
             force: out.force,
             torque_i: -(nxft * ri) + out.rolling_torque,
             torque_j: -(nxft * rj) - out.rolling_torque,
-            scalars: ScalarFlows::ZERO,
         };
         match cohesion {
             None => Some(contact),
@@ -462,7 +443,6 @@ impl<'a> Context<'a> {
                     force: contact.force + bond.force,
                     torque_i: contact.torque_i + bond.torque_i,
                     torque_j: contact.torque_j + bond.torque_j,
-                    scalars: ScalarFlows::ZERO,
                 })
             }
         }
@@ -512,7 +492,6 @@ impl<'a> Context<'a> {
             force: normal * out.normal_n + out.tangential_n,
             torque_i: -(nxft * ri),
             torque_j: -(nxft * rj),
-            scalars: ScalarFlows::ZERO,
         }
     }
 
@@ -1111,17 +1090,29 @@ fn parallel<P: PassKind>(
                         continue;
                     }
                     let local = k - base;
-                    match ctx.pair::<P>(i, &bi, j, &vel, &mut hist, local, k, &mut worst, &mut crossings) {
+                    let mut flows = ScalarFlows::ZERO;
+                    match ctx.pair::<P>(
+                        i,
+                        &bi,
+                        j,
+                        &vel,
+                        &mut hist,
+                        local,
+                        k,
+                        &mut worst,
+                        &mut crossings,
+                        &mut flows,
+                    ) {
                         Some(res) => {
                             fb[local] = res.force;
                             tib[local] = res.torque_i;
                             tjb[local] = res.torque_j;
                             onb[local] = true;
-                            if P::WIDE && ctx.channels {
-                                sb[local] = res.scalars;
-                            }
                         }
                         None => onb[local] = false,
+                    }
+                    if P::WIDE && ctx.channels {
+                        sb[local] = flows;
                     }
                 }
             }
@@ -1283,6 +1274,7 @@ fn sweep_body<P: PassKind, const CROSS: bool>(
             let j = j as usize - lo;
             if !CROSS || j < local_hi {
                 let slot = k + window.pair_base;
+                let mut flows = ScalarFlows::ZERO;
                 if let Some(res) = ctx.pair::<P>(
                     il,
                     &bi,
@@ -1293,24 +1285,25 @@ fn sweep_body<P: PassKind, const CROSS: bool>(
                     slot,
                     &mut tally.worst,
                     &mut tally.well_crossings,
+                    &mut flows,
                 ) {
                     force[il] += res.force;
                     force[j] -= res.force;
                     torque[il] += res.torque_i;
                     torque[j] += res.torque_j;
-                    if P::WIDE && ctx.channels {
-                        channels.add(il, &res.scalars);
-                        channels.add(j, &res.scalars.for_partner());
-                    }
+                }
+                if P::WIDE && ctx.channels {
+                    channels.add(il, &flows);
+                    channels.add(j, &flows.for_partner());
                 }
             } else {
                 let k = k + window.pair_base;
                 if buffers.acted[k] {
                     force[il] += buffers.force_on_i[k];
                     torque[il] += buffers.torque_on_i[k];
-                    if P::WIDE && ctx.channels {
-                        channels.add(il, &buffers.scalars_on_i[k]);
-                    }
+                }
+                if P::WIDE && ctx.channels {
+                    channels.add(il, &buffers.scalars_on_i[k]);
                 }
             }
         }
@@ -1436,9 +1429,9 @@ fn range_sweep<P: PassKind>(
         if buffers.acted[k] {
             force[j] -= buffers.force_on_i[k];
             torque[j] += buffers.torque_on_j[k];
-            if P::WIDE && ctx.channels {
-                channels.add(j, &buffers.scalars_on_i[k].for_partner());
-            }
+        }
+        if P::WIDE && ctx.channels {
+            channels.add(j, &buffers.scalars_on_i[k].for_partner());
         }
     }
     let local_hi = hi - lo;
