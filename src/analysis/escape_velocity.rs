@@ -18,12 +18,8 @@ pub const START_GAP_M: f64 = 1e-7;
 /// Contact times after the first touch within which a pair must have left the contact to count as escaping.
 const MAX_CONTACT_TIMES: u64 = 100;
 
-/// The restitution coefficient of a linear spring–dashpot (seed 001 App. B): e = exp(−πα/√(1 − α²)) with
-/// α = η/(2√(μK)), μ the reduced mass.
-pub fn linear_spring_restitution(stiffness_n_per_m: f64, damping_kg_per_s: f64, reduced_mass_kg: f64) -> f64 {
-    let alpha = damping_kg_per_s / (2.0 * (reduced_mass_kg * stiffness_n_per_m).sqrt());
-    (-std::f64::consts::PI * alpha / (1.0 - alpha * alpha).sqrt()).exp()
-}
+/// The restitution coefficient of a linear spring–dashpot (the contact law's property, `engine::models::normal`).
+pub use crate::engine::models::normal::linear_spring_restitution;
 
 /// A head-on collision of two equal spheres (seed 001 Table 6.2 contact: linear spring–dashpot, no cohesion model
 /// inside the contact besides the constant Hamaker force below H_cut).

@@ -128,7 +128,7 @@ mod tests {
     #[test]
     fn b5_square_well_escape_velocities_match_seed_001_table_7_1() {
         let mass = 1.3875e-6;
-        let restitution = crate::analysis::escape_velocity::linear_spring_restitution(800.0, 0.79e-3, mass / 2.0);
+        let restitution = crate::engine::models::normal::linear_spring_restitution(800.0, 0.79e-3, mass / 2.0);
         assert!((restitution - 0.9487).abs() < 1e-4, "{restitution}");
         for (d_erg, v_cm_per_s) in [(1e-4, 0.179), (5e-4, 0.400), (1e-3, 0.566)] {
             let well = SquareWell {

@@ -55,6 +55,13 @@ pub struct NormalOutput {
     pub viscoelastic_damping_kg_per_s: f64,
 }
 
+/// The restitution coefficient of a linear spring–dashpot (seed 001 App. B): e = exp(−πα/√(1 − α²)) with
+/// α = η/(2√(μK)), μ the reduced mass.
+pub fn linear_spring_restitution(stiffness_n_per_m: f64, damping_kg_per_s: f64, reduced_mass_kg: f64) -> f64 {
+    let alpha = damping_kg_per_s / (2.0 * (reduced_mass_kg * stiffness_n_per_m).sqrt());
+    (-std::f64::consts::PI * alpha / (1.0 - alpha * alpha).sqrt()).exp()
+}
+
 impl NormalModel {
     /// Checks the law's own parameters: `Err((key under contact.normal, what was expected))`.
     pub fn check(&self) -> Result<(), (&'static str, String)> {
