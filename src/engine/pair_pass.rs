@@ -515,6 +515,41 @@ impl<'a> Context<'a> {
         worst: &mut WorstOverlap,
         crossings: &mut u64,
     ) -> ScalarFlows {
+        if !P::WIDE {
+            // The narrow pass's wall loop, written out: the contact part of [`Context::wall_slot`] with the force
+            // added in place. The same loop through `wall_slot` (which also serves cohesion and channels) made the
+            // dry benchmark 4-7 % slower, although every wide branch is a compile-time `false` there
+            // (`docs/performance.md`); the two must compute the same contact (tests/engine_reference.rs pins it).
+            let ri = self.radius_m[i];
+            for (offset, &w) in wall_ids.iter().enumerate() {
+                let k = first_slot + offset;
+                let wall = &self.config.walls[w as usize];
+                let prox = wall.proximity(&x, self.wall_angle[w as usize]);
+                let overlap = ri - prox.gap_m;
+                if overlap <= 0.0 {
+                    hist.release_as::<P>(k);
+                    continue;
+                }
+                worst.note(overlap, ri, i, u32::MAX - w as u32);
+                let n = prox.normal;
+                let kin = ContactKinematics {
+                    normal: n,
+                    overlap_m: overlap,
+                    effective_radius_m: ri,
+                    effective_mass_kg: self.mass_kg[i],
+                    contact_velocity: vi - (wi * ri).cross(&n) - prox.wall_velocity,
+                    normal_velocity_m_per_s: (vi - prox.wall_velocity).dot(&n),
+                    relative_angular_velocity: wi - prox.wall_angular_velocity,
+                };
+                let mat = self.table.get(self.species[i], wall.species);
+                let mut h = hist.load_as::<P>(k);
+                let out = self.law.evaluate(mat, &kin, self.dt_s, &mut h);
+                hist.save_as::<P>(k, &h);
+                *f += out.force;
+                *t += -(n.cross(&out.tangential_force) * ri) + out.rolling_torque;
+            }
+            return ScalarFlows::ZERO;
+        }
         let mut flows = ScalarFlows::ZERO;
         let mut touches_a_wall = false;
         for (offset, &w) in wall_ids.iter().enumerate() {
