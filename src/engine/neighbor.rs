@@ -11,23 +11,10 @@
 use super::Vec3;
 use super::contacts::split_at_ends;
 use super::geometry::{Domain, Wall};
-use super::team::Team;
+use super::team::{Team, map_indices};
 
 /// Particles per work item in the build.
 pub const BUILD_CHUNK: usize = 1024;
-
-/// `f` over `0..n`, collected in order: on `team`'s threads in parts of `part_len` indices when the team has
-/// several threads, else on the calling thread. A simulation passes the force pass's team, whose helpers are still
-/// spinning from the last force pass, so the hand-over costs no thread wake-up. Results are the same either way.
-pub fn map_indices<T: Send>(team: &Team, n: usize, part_len: usize, f: impl Fn(usize) -> T + Sync) -> Vec<T> {
-    if team.size() == 1 || n <= part_len {
-        return (0..n).map(f).collect();
-    }
-    let results = team.map_chunks(n, part_len, |part| part.map(&f).collect::<Vec<T>>());
-    let mut out = Vec::with_capacity(n);
-    results.into_iter().for_each(|mut part| out.append(&mut part));
-    out
-}
 
 /// How far beyond contact particles interact with each other and with walls (a cohesion model's range): the list
 /// holds every pair whose surfaces are closer than this plus the skin.
