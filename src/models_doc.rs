@@ -69,9 +69,12 @@ cohesion (optional, one of):
                                                                          Young-Laplace table)
   hamaker: { constant_j, inner_cutoff_m, outer_cutoff_m, walls? }        seed 001 eqs. 6.34-6.37
   square_well: { depth_j, outer_to_inner_radius_ratio, walls? }          seed 001 eqs. 3.6-3.11 as impulses
-species: { name, radius_m, density_kg_per_m3, youngs_modulus_pa, poisson_ratio, friction_coefficient,
-           yield_force_n?, rolling_friction_coefficient?, thermal_conductivity_w_per_m_k?, heat_capacity_j_per_kg_k?,
-           contact_angle_deg?, liquid_content? }
+species: { name, material?, radius_m, density_kg_per_m3, youngs_modulus_pa, poisson_ratio, friction_coefficient,
+           yield_force_n?, rolling_friction_coefficient?, real_youngs_modulus_pa?, thermal_conductivity_w_per_m_k?,
+           heat_capacity_j_per_kg_k?, contact_angle_deg?, liquid_content? }
+  material: glass | steel | aluminium                                    seed 000 Table 7; fills what is not given
+                                                                         (a youngs_modulus_pa given beside it is
+                                                                         the softened one, the material's the real)
 walls (list of):
   box: { species }                                                       planes on every non-periodic face
   plane: { name, species, point_m, normal }
@@ -81,11 +84,25 @@ walls (list of):
              segment: { start_m, end_m, half_thickness_m }
 gravity: { vector_m_per_s2, flip?: { axis: x|y|z, frequency_hz } }       flip: seed 000 zig-zag chute
 fill (list of):
-  lattice: { species, spacing_m, lo_m, hi_m, origin_m?, inside_drum? }
-  random: { species, count, lo_m, hi_m, inside_drum? }
+  lattice: { species, spacing_m, lo_m, hi_m, origin_m?, inside_drum?, jitter_m?, temperature_k? }
+  random: { species, count, lo_m, hi_m, inside_drum?, temperature_k? }
+  explicit: { species, positions_m, velocities_m_per_s?, angular_velocities_rad_per_s?, temperature_k? }
 time: { end_time_s, dt_s | dt_fraction_of_contact_time, reference_velocity_m_per_s? }
+heat (optional: particle temperatures and conduction, seed 000 chapter 5):
+     { initial_temperature_k, walls?: { <wall name>: { temperature_k } | { adiabatic: true } },
+       soft_contact_correction? }                                        Q = 2 R_c k_s ΔT (eqs. 5.3-5.4), R_c the
+                                                                         Hertz radius, k_s the harmonic mean; walls
+                                                                         not listed are adiabatic; the correction
+                                                                         (default on) scales R_c by
+                                                                         (E*_sim/E*_real)^(1/5)
+  gas?: { conductivity_w_per_m_k?, heat_capacity_j_per_kg_k?, nusselt?,  with a gas: eq. 5.8 on the grid and
+          initial_temperature_k?, inlet_temperature_k?,                  Q_f = h_gp S_p (T_gas - T_p), eq. 5.5;
+          jet_temperatures_k? }                                          defaults: Table 7's air
+    nusselt: seed000: { coefficient? } (default, 1.8)                    eqs. 5.6-5.7
+             ranz_marshall                                               Nu = 2 + 0.6 Re^1/2 Pr^1/3
+             gunn                                                        Gunn (1978), beds
 gas (optional: a gas coupled to the particles, fluidized beds):
-     { density_kg_per_m3, viscosity_pa_s, cells: [nx, ny, nz], dem_steps_per_gas_step, sides?, jets?, blocked?,
+     { vacuum?, density_kg_per_m3, viscosity_pa_s, cells: [nx, ny, nz], dem_steps_per_gas_step, sides?, jets?, blocked?,
        drag?, drag_velocities?, drag_coupling?, porosity?, min_porosity?, convection?, solver?, inflow_ramp?,
        inflow_levels?, pressure_probe_height_m? }
   sides: { x_low?, x_high?, y_low?, y_high?, z_low?, z_high? }, each one of:

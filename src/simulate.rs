@@ -85,11 +85,35 @@ pub fn checkpoint_meta(built: &BuiltScenario) -> CheckpointMeta {
 pub const GAS_SERIES_COLUMNS: &str = ",column_pressure_drop_pa,probe_pressure_drop_pa,node_pressure_drop_pa,\
 node_weight_per_area_pa,gas_outer_iterations,gas_linear_iterations,gas_mass_imbalance";
 
+/// The series columns of a run with heat transfer: the particles' mass-weighted mean temperature and the coldest and
+/// hottest particle's, K.
+const HEAT_SERIES_COLUMNS: &str = ",mean_temperature_k,min_temperature_k,max_temperature_k";
+
+/// The heat columns ([`HEAT_SERIES_COLUMNS`]), empty without heat transfer.
+fn heat_columns(sim: &Simulation) -> String {
+    let p = &sim.particles;
+    if p.temperature_k.is_empty() {
+        return String::new();
+    }
+    let mass: f64 = p.mass_kg.iter().sum();
+    let mean = p.mass_kg.iter().zip(&p.temperature_k).map(|(m, t)| m * t).sum::<f64>() / mass;
+    let (lo, hi) = p
+        .temperature_k
+        .iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), &t| {
+            (lo.min(t), hi.max(t))
+        });
+    format!(",{mean:e},{lo:e},{hi:e}")
+}
+
 /// The series header of a scenario (before any observer columns).
 pub fn series_header(built: &BuiltScenario) -> String {
     let mut header = SERIES_HEADER.to_string();
     if built.gas.is_some() {
         header.push_str(GAS_SERIES_COLUMNS);
+    }
+    if built.config.heat.is_some() {
+        header.push_str(HEAT_SERIES_COLUMNS);
     }
     if built.spec.output.net_forces {
         header.push_str(",weight_n,fluid_force_up_n");
@@ -206,8 +230,9 @@ fn series_row(sim: &mut Simulation, built: &BuiltScenario) -> String {
     let (pairs, walls) = sim.contact_counts();
     let n = sim.particles.len().max(1) as f64;
     let gas = gas_columns(sim, built.gas.as_ref().and_then(|g| g.pressure_probe_height_m));
+    let heat = heat_columns(sim);
     format!(
-        "{},{:e},{:e},{:e},{:e},{:e},{},{},{:.6}{gas}{net}",
+        "{},{:e},{:e},{:e},{:e},{:e},{},{},{:.6}{gas}{heat}{net}",
         sim.step,
         sim.time_s,
         sim.particles.kinetic_energy_j(),

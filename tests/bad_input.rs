@@ -256,21 +256,138 @@ const CASES: &[(&str, &str, &str, &[&str])] = &[
     ),
 ];
 
+/// A scenario with heat transfer, and its bad variants.
+const GOOD_HEAT: &str = r#"
+name: ok-heat
+domain: { lo_m: [0.0, 0.0, 0.0], hi_m: [0.02, 0.02, 0.05] }
+gravity: { vector_m_per_s2: [0.0, 0.0, -9.81] }
+species:
+  - { name: glass, radius_m: 0.001, density_kg_per_m3: 2500.0, youngs_modulus_pa: 1.0e7, poisson_ratio: 0.3, friction_coefficient: 0.3, thermal_conductivity_w_per_m_k: 1.0, heat_capacity_j_per_kg_k: 800.0 }
+contact: { normal: { hertz: { restitution: 0.9 } }, tangential: mindlin }
+walls:
+  - box: { species: glass }
+fill:
+  - lattice: { species: glass, spacing_m: 0.0025, lo_m: [0.001, 0.001, 0.001], hi_m: [0.019, 0.019, 0.02] }
+time: { dt_s: 1.0e-5, end_time_s: 0.001 }
+heat:
+  initial_temperature_k: 300.0
+  walls: { box_z_lo: { temperature_k: 400.0 } }
+"#;
+
+const HEAT_CASES: &[(&str, &str, &str, &[&str])] = &[
+    (
+        "a negative conductivity",
+        "thermal_conductivity_w_per_m_k: 1.0",
+        "thermal_conductivity_w_per_m_k: -1.0",
+        &[
+            "species[0].thermal_conductivity_w_per_m_k",
+            "expected a finite value > 0, got -1",
+        ],
+    ),
+    (
+        "a zero heat capacity",
+        "heat_capacity_j_per_kg_k: 800.0",
+        "heat_capacity_j_per_kg_k: 0.0",
+        &[
+            "species[0].heat_capacity_j_per_kg_k",
+            "expected a finite value > 0, got 0",
+        ],
+    ),
+    (
+        "an initial temperature below 0 K",
+        "initial_temperature_k: 300.0",
+        "initial_temperature_k: -5.0",
+        &[
+            "heat.initial_temperature_k",
+            "expected an absolute temperature > 0 K, got -5",
+        ],
+    ),
+    (
+        "a fill at 0 K",
+        "hi_m: [0.019, 0.019, 0.02] }",
+        "hi_m: [0.019, 0.019, 0.02], temperature_k: 0.0 }",
+        &[
+            "fill[0].lattice.temperature_k",
+            "expected an absolute temperature > 0 K, got 0",
+        ],
+    ),
+    (
+        "a heated wall without a temperature",
+        "walls: { box_z_lo: { temperature_k: 400.0 } }",
+        "walls: { box_z_lo: {} }",
+        &[
+            "heat.walls.box_z_lo",
+            "expected the wall's `temperature_k` (a heated wall) or `adiabatic: true`",
+        ],
+    ),
+    (
+        "a wall that does not exist",
+        "walls: { box_z_lo: { temperature_k: 400.0 } }",
+        "walls: { drum: { temperature_k: 400.0 } }",
+        &["heat.walls.drum", "no wall named 'drum'", "box_z_lo"],
+    ),
+    (
+        "heat on without thermal properties",
+        ", thermal_conductivity_w_per_m_k: 1.0, heat_capacity_j_per_kg_k: 800.0 }",
+        " }",
+        &[
+            "species[0].thermal_conductivity_w_per_m_k",
+            "heat transfer is on",
+            "or a `material`",
+        ],
+    ),
+    (
+        "a gas with a negative conductivity",
+        "  walls: { box_z_lo: { temperature_k: 400.0 } }",
+        "  walls: { box_z_lo: { temperature_k: 400.0 } }\n  gas: { conductivity_w_per_m_k: -0.02 }",
+        &[
+            "heat.gas.conductivity_w_per_m_k",
+            "expected a finite value > 0, got -0.02",
+        ],
+    ),
+    (
+        "an unknown material",
+        "  - { name: glass, radius_m",
+        "  - { name: glass, material: granite, radius_m",
+        &["unknown variant `granite`", "glass", "steel", "aluminium"],
+    ),
+];
+
+/// A fill temperature without a `heat` section.
+const NO_HEAT_CASES: &[(&str, &str, &str, &[&str])] = &[(
+    "a fill temperature without heat",
+    "hi_m: [0.019, 0.019, 0.02] }",
+    "hi_m: [0.019, 0.019, 0.02], temperature_k: 350.0 }",
+    &["fill[0].lattice.temperature_k", "needs a `heat` section"],
+)];
+
 #[test]
 fn bad_scenarios_fail_cleanly_before_writing_anything() {
+    check_cases(GOOD, CASES);
+    check_cases(GOOD, NO_HEAT_CASES);
+}
+
+#[test]
+fn bad_heat_input_fails_cleanly_before_writing_anything() {
+    check_cases(GOOD_HEAT, HEAT_CASES);
+}
+
+/// Runs `good` (which must succeed) and each case's edit of it (which must fail at the edited line, exit 2, with
+/// every fragment in its one-line message, and write nothing).
+fn check_cases(good: &str, cases: &[(&str, &str, &str, &[&str])]) {
     let tmp = tempfile::tempdir().expect("temp dir");
     let dir = tmp.path();
     // The good file runs, so each failure below is due to its one change.
-    std::fs::write(dir.join("good.yaml"), GOOD).expect("write");
+    std::fs::write(dir.join("good.yaml"), good).expect("write");
     let ok = granflow(&["simulate", "good.yaml", "--out", "good-out", "--quiet"], dir);
     assert!(ok.status.success(), "{}", String::from_utf8_lossy(&ok.stderr));
 
-    for (case, from, to, fragments) in CASES {
+    for (case, from, to, fragments) in cases {
         assert!(
-            GOOD.contains(from),
+            good.contains(from),
             "case '{case}': '{from}' is not in the good scenario"
         );
-        std::fs::write(dir.join("bad.yaml"), GOOD.replacen(from, to, 1)).expect("write");
+        std::fs::write(dir.join("bad.yaml"), good.replacen(from, to, 1)).expect("write");
         let out = granflow(&["simulate", "bad.yaml", "--out", "bad-out"], dir);
         let stderr = String::from_utf8_lossy(&out.stderr);
         assert_eq!(out.status.code(), Some(2), "case '{case}': exit code, stderr: {stderr}");
@@ -278,7 +395,7 @@ fn bad_scenarios_fail_cleanly_before_writing_anything() {
             assert!(stderr.contains(f), "case '{case}': message lacks '{f}': {stderr}");
         }
         // Every message names the line of the edit (or, for an edit of several lines, one of them).
-        let first_line = GOOD[..GOOD.find(from).expect("checked above")].matches('\n').count() + 1;
+        let first_line = good[..good.find(from).expect("checked above")].matches('\n').count() + 1;
         let lines = first_line..=first_line + to.lines().count().max(1) - 1;
         let line: Option<usize> = stderr
             .strip_prefix("error: bad.yaml:")

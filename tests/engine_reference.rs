@@ -60,6 +60,9 @@ pub fn digests(s: &SimState) -> BTreeMap<String, String> {
     d.insert("particles.torque_n_m".into(), vectors(&p.torque_n_m));
     d.insert("particles.liquid_m3".into(), floats(&p.liquid_m3));
     d.insert("particles.sprayed_m3".into(), floats(&p.sprayed_m3));
+    if !p.temperature_k.is_empty() {
+        d.insert("particles.temperature_k".into(), floats(&p.temperature_k));
+    }
     // The channels where a run records them (none of the reference runs does: their digests predate channels).
     for info in granflow::engine::channels::CHANNELS {
         let values = (info.get)(&p.channels);

@@ -13,7 +13,7 @@ use granflow::engine::gas::coupled::{GasCoupling, GasScalarId};
 use granflow::engine::gas::coupling::PorosityMethod;
 use granflow::engine::gas::fluid_forces::DragVelocities;
 use granflow::engine::gas::simple::InletFace;
-use granflow::engine::gas::{Boundary, Convection, GasConfig, GasScalarSpec, Grid, ScalarWall};
+use granflow::engine::gas::{Boundary, Convection, GasConfig, GasScalarSpec, Grid, ScalarExchange, ScalarWall};
 use granflow::engine::models::drag::DragLaw;
 
 const RHO: f64 = 1.2;
@@ -66,6 +66,7 @@ fn spec(name: &'static str, diffusion_kg_per_m_s: f64, initial_value: f64, inlet
         inlet_value,
         jet_values: Vec::new(),
         walls: [ScalarWall::ZeroFlux; 6],
+        exchange: ScalarExchange::Implicit,
     }
 }
 

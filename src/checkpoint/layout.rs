@@ -23,12 +23,16 @@ use super::{CheckpointError, CheckpointMeta};
 use crate::engine::Vec3;
 use crate::engine::channels::{CHANNELS, ChannelInfo, ParticleChannels};
 use crate::engine::contacts::{ContactStore, WallId};
-use crate::engine::gas::coupled::{GasSnapshot, GasStepStats};
+use crate::engine::gas::ExchangeAccumulator;
+use crate::engine::gas::coupled::{GasScalarSnapshot, GasSnapshot, GasStepStats};
 use crate::engine::models::ContactHistory;
 use crate::engine::models::history::{FieldKind, FieldValue, HISTORY_FIELDS, HistoryField};
 use crate::engine::net_force::NetForceTally;
 use crate::engine::particles::{ParticleId, Particles, SpeciesId};
 use crate::engine::state::{RngState, SimState};
+
+/// The name of the gas temperature among the gas's transported scalars.
+const GAS_TEMPERATURE: &str = "temperature_k";
 
 /// Value of the root attribute `format`.
 pub(crate) const FORMAT_NAME: &str = "granflow-checkpoint";
@@ -58,8 +62,12 @@ pub(crate) enum Rows {
     NetForce,
     /// The number of walls when the run sums net forces by mechanism, 0 otherwise.
     NetForceWalls,
-    /// N when the run records the scalar channels (`engine::channels`), 0 otherwise.
-    ParticleChannels,
+    /// N when the run has what the dataset holds (a scalar channel's group, temperatures), 0 otherwise.
+    ParticlesIfRecorded,
+    /// The number of gas cells when the gas carries a temperature, 0 otherwise.
+    GasCellsIfHeat,
+    /// One value when the gas carries a temperature, none otherwise.
+    GasScalarIfHeat,
 }
 
 /// One dataset of the layout.
@@ -214,7 +222,7 @@ impl HistoryTable {
 fn channel_spec(info: &ChannelInfo) -> DatasetSpec {
     DatasetSpec {
         path: info.path,
-        rows: Rows::ParticleChannels,
+        rows: Rows::ParticlesIfRecorded,
         width: 1,
         units: info.unit,
         dtype: <f64 as Element>::NAME,
@@ -374,9 +382,13 @@ datasets! {
     gas_last_linear_iterations: u64 => "gas/last_step/linear_iterations", Rows::GasScalar, 1, "1";
     gas_last_mass_imbalance: f64 => "gas/last_step/mass_imbalance", Rows::GasScalar, 1, "1";
     gas_last_converged: u8 => "gas/last_step/converged", Rows::GasScalar, 1, "1";
+    gas_temperature_k: f64 => "gas/temperature_k", Rows::GasCellsIfHeat, 1, "K";
+    gas_heat_transfer_sum: f64 => "gas/heat_transfer_sum_k_kg_per_m3_s", Rows::GasCellsIfHeat, 1, "K kg/(m3 s)";
+    gas_heat_exchange_steps: u32 => "gas/heat_exchange_steps", Rows::GasScalarIfHeat, 1, "1";
 
     liquid_m3: f64 => "particles/liquid_m3", Rows::Particles, 1, "m3";
     sprayed_m3: f64 => "particles/sprayed_m3", Rows::Particles, 1, "m3";
+    temperature_k: f64 => "particles/temperature_k", Rows::ParticlesIfRecorded, 1, "K";
 
     net_force_steps: u64 => "net_force/steps", Rows::NetForce, 1, "1";
     net_force_fluid_n: f64 => "net_force/fluid_sum_n", Rows::NetForce, 3, "N";
@@ -421,6 +433,8 @@ impl Arrays {
     pub(crate) fn from_state(state: &SimState) -> Arrays {
         let p = &state.particles;
         let gas = state.gas.as_ref();
+        // The one transported scalar a checkpoint holds today: the gas temperature of a run with heat transfer.
+        let gas_temperature = gas.and_then(|g| g.scalars.iter().find(|s| s.name == GAS_TEMPERATURE));
         Arrays {
             particle_id: p.id.iter().map(|id| id.0).collect(),
             particle_species: p.species.iter().map(|s| s.0).collect(),
@@ -478,9 +492,15 @@ impl Arrays {
             gas_last_linear_iterations: gas.map(|g| g.last.linear_iterations).into_iter().collect(),
             gas_last_mass_imbalance: gas.map(|g| g.last.mass_imbalance).into_iter().collect(),
             gas_last_converged: gas.map(|g| u8::from(g.last.converged)).into_iter().collect(),
+            gas_temperature_k: gas_temperature.map(|s| s.value.clone()).unwrap_or_default(),
+            gas_heat_transfer_sum: gas_temperature
+                .map(|s| s.exchange.transfer_sum.clone())
+                .unwrap_or_default(),
+            gas_heat_exchange_steps: gas_temperature.map(|s| s.exchange.steps).into_iter().collect(),
 
             liquid_m3: p.liquid_m3.clone(),
             sprayed_m3: p.sprayed_m3.clone(),
+            temperature_k: p.temperature_k.clone(),
 
             net_force_steps: state.net_force.as_ref().map(|t| t.steps).into_iter().collect(),
             net_force_fluid_n: state
@@ -557,12 +577,28 @@ impl Arrays {
                 return Err(format!("/{path} has {len} values but /gas/time_s has {gas_scalars}"));
             }
         }
-        let channel_rows = (CHANNELS[0].get)(&self.channels).len();
-        if channel_rows != 0 && channel_rows != n {
+        let gas_cells = self.gas_pressure_pa.len();
+        let heat_cells = self.gas_temperature_k.len();
+        if heat_cells != 0
+            && (heat_cells != gas_cells
+                || self.gas_heat_transfer_sum.len() != gas_cells
+                || self.gas_heat_exchange_steps.len() != 1)
+        {
             return Err(format!(
-                "/{} has {channel_rows} rows, expected 0 or one per particle ({n})",
-                CHANNELS[0].path
+                "/gas/temperature_k has {heat_cells} values, /gas/heat_transfer_sum_k_kg_per_m3_s {} and \
+                 /gas/heat_exchange_steps {}, expected one per gas cell ({gas_cells}) and one",
+                self.gas_heat_transfer_sum.len(),
+                self.gas_heat_exchange_steps.len()
             ));
+        }
+        let optional = CHANNELS
+            .iter()
+            .map(|info| (info.path, (info.get)(&self.channels).len()))
+            .chain([("particles/temperature_k", self.temperature_k.len())]);
+        for (path, rows) in optional {
+            if rows != 0 && rows != n {
+                return Err(format!("/{path} has {rows} rows, expected 0 or one per particle ({n})"));
+            }
         }
         let tallies = self.net_force_steps.len();
         let tally_walls = self.net_force_wall_contact_n.len() / 3;
@@ -601,6 +637,7 @@ impl Arrays {
             torque_n_m: unflatten(&self.torque_n_m),
             liquid_m3: self.liquid_m3,
             sprayed_m3: self.sprayed_m3,
+            temperature_k: self.temperature_k,
             channels: self.channels,
         };
         let record = |active: u8, history: &HistoryArrays, k: usize| {
@@ -632,6 +669,7 @@ impl Arrays {
         let mut seed = [0u8; 32];
         seed.copy_from_slice(&self.rng_seed);
         let word_pos = (u128::from(self.rng_word_pos_hi[0]) << 64) | u128::from(self.rng_word_pos_lo[0]);
+        let cells = self.gas_pressure_pa.len();
         let gas = (self.gas_time_s.len() == 1).then(|| GasSnapshot {
             pressure_pa: self.gas_pressure_pa,
             velocity_m_per_s: [self.gas_velocity_x, self.gas_velocity_y, self.gas_velocity_z],
@@ -647,7 +685,20 @@ impl Arrays {
                 mass_imbalance: self.gas_last_mass_imbalance[0],
                 converged: self.gas_last_converged[0] == 1,
             },
-            scalars: Vec::new(),
+            scalars: (self.gas_temperature_k.len() == cells && cells > 0)
+                .then(|| GasScalarSnapshot {
+                    name: GAS_TEMPERATURE.into(),
+                    unit: "K".into(),
+                    value: self.gas_temperature_k,
+                    exchange: ExchangeAccumulator {
+                        coefficient_sum: vec![0.0; cells],
+                        coefficient_value_sum: vec![0.0; cells],
+                        transfer_sum: self.gas_heat_transfer_sum,
+                        steps: self.gas_heat_exchange_steps.first().copied().unwrap_or(0),
+                    },
+                })
+                .into_iter()
+                .collect(),
         });
         let net_force = (self.net_force_steps.len() == 1).then(|| NetForceTally {
             steps: self.net_force_steps[0],
@@ -692,6 +743,8 @@ impl Visitor for ShapeCheck {
                 n * spec.width
             )),
             Rows::Scalar | Rows::Fixed(_) => Ok(()),
+            // Each of these is 0 or N rows on its own ([`Arrays::check`]).
+            Rows::ParticlesIfRecorded | Rows::GasCellsIfHeat | Rows::GasScalarIfHeat => Ok(()),
             _ if !len.is_multiple_of(spec.width) => Err(format!(
                 "/{} has {len} elements, not a multiple of {}",
                 spec.path, spec.width

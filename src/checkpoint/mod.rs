@@ -31,7 +31,7 @@ use crate::engine::SimState;
 
 /// Version of the file layout. Bump it whenever a name, type, shape or the checksum definition changes; readers
 /// reject any other version with [`CheckpointError::Version`].
-pub const CHECKPOINT_FORMAT_VERSION: u32 = 6;
+pub const CHECKPOINT_FORMAT_VERSION: u32 = 7;
 
 /// Metadata stored beside the state.
 #[derive(Debug, Clone, PartialEq)]
@@ -412,7 +412,9 @@ fn expected_shape(spec: &DatasetSpec) -> String {
         Rows::GasScalar => "0 or 1".to_string(),
         Rows::NetForce => "0 or 1".to_string(),
         Rows::NetForceWalls => "0 or walls".to_string(),
-        Rows::ParticleChannels => "0 or N".to_string(),
+        Rows::ParticlesIfRecorded => "0 or N".to_string(),
+        Rows::GasCellsIfHeat => "0 or gas cells".to_string(),
+        Rows::GasScalarIfHeat => "0 or 1".to_string(),
     };
     if spec.width == 1 {
         format!("[{rows}]")
@@ -425,7 +427,7 @@ fn expected_shape(spec: &DatasetSpec) -> String {
 mod tests {
     use super::*;
     use crate::engine::Vec3;
-    use crate::engine::channels::{CHANNELS, ParticleChannels};
+    use crate::engine::channels::{CHANNELS, ChannelGroups, ParticleChannels};
     use crate::engine::contacts::{ContactStore, WallId};
     use crate::engine::models::ContactHistory;
     use crate::engine::models::history::{CohesionHistory, DurationHistory, NormalHistory, TangentialHistory};
@@ -491,9 +493,16 @@ mod tests {
                 .push(v(-1.0e-9 * f, f64::from_bits(0x7ff8_0000_dead_beef), f64::MAX / f));
             p.liquid_m3.push(1.0e-12 / f);
             p.sprayed_m3.push(3.0e-13 * f);
+            p.temperature_k.push(293.15 + f / 3.0);
         }
         p.position_m[2].x = DISTINCTIVE;
-        p.channels = ParticleChannels::new(5, true);
+        p.channels = ParticleChannels::new(
+            5,
+            ChannelGroups {
+                statistics: true,
+                heat: true,
+            },
+        );
         for (k, info) in CHANNELS.iter().enumerate() {
             for (i, x) in (info.get_mut)(&mut p.channels).iter_mut().enumerate() {
                 *x = 1.25e-3 * (k + 1) as f64 + i as f64;
@@ -556,7 +565,17 @@ mod tests {
                     mass_imbalance: 1.25e-9,
                     converged: true,
                 },
-                scalars: Vec::new(),
+                scalars: vec![crate::engine::gas::coupled::GasScalarSnapshot {
+                    name: "temperature_k".into(),
+                    unit: "K".into(),
+                    value: vec![300.0, 301.5, 1e-300, 400.0, 299.25, 350.125],
+                    exchange: crate::engine::gas::ExchangeAccumulator {
+                        coefficient_sum: vec![0.0; 6],
+                        coefficient_value_sum: vec![0.0; 6],
+                        transfer_sum: vec![-0.5, 2.0e-9, 0.0, 3.25, -7.0, 1.0],
+                        steps: 3,
+                    },
+                }],
             }),
         }
     }
@@ -763,19 +782,19 @@ mod tests {
             let file = hdf5::File::open_rw(&path).expect("open");
             file.attr("format_version")
                 .expect("attr")
-                .write_scalar(&7u32)
+                .write_scalar(&(CHECKPOINT_FORMAT_VERSION + 1))
                 .expect("write attr");
         }
         seal(&path).expect("reseal");
-        let err = read_checkpoint(&path).expect_err("version 7 must be rejected");
+        let err = read_checkpoint(&path).expect_err("the next version must be rejected");
         assert!(
             matches!(
                 err,
                 CheckpointError::Version {
-                    found: 7,
+                    found,
                     expected: CHECKPOINT_FORMAT_VERSION,
                     ..
-                }
+                } if found == CHECKPOINT_FORMAT_VERSION + 1
             ),
             "{err:?}"
         );
@@ -1103,8 +1122,24 @@ mod tests {
             &gas.last.mass_imbalance.to_bits().to_le_bytes(),
         );
         ds(&mut b, "gas/last_step/converged", &[1], &[u8::from(gas.last.converged)]);
+        let heat = &gas.scalars[0];
+        ds(&mut b, "gas/temperature_k", &[6], &f(heat.value.iter().copied()));
+        let transfer = f(heat.exchange.transfer_sum.iter().copied());
+        ds(&mut b, "gas/heat_transfer_sum_k_kg_per_m3_s", &[6], &transfer);
+        ds(
+            &mut b,
+            "gas/heat_exchange_steps",
+            &[1],
+            &heat.exchange.steps.to_le_bytes(),
+        );
         ds(&mut b, "particles/liquid_m3", &[n], &f(p.liquid_m3.iter().copied()));
         ds(&mut b, "particles/sprayed_m3", &[n], &f(p.sprayed_m3.iter().copied()));
+        ds(
+            &mut b,
+            "particles/temperature_k",
+            &[n],
+            &f(p.temperature_k.iter().copied()),
+        );
         let tally = state.net_force.as_ref().expect("the sample records net forces");
         let walls = tally.wall_contact_n.len();
         ds(&mut b, "net_force/steps", &[1], &tally.steps.to_le_bytes());
@@ -1159,6 +1194,7 @@ mod tests {
             ("wall_contacts_ended", &c.wall_contacts_ended),
             ("wall_contact_time_ended_s", &c.wall_contact_time_ended_s),
             ("wall_contact_time_s", &c.wall_contact_time_s),
+            ("heat_flow_w", &c.heat_flow_w),
         ] {
             ds(
                 &mut b,

@@ -9,8 +9,10 @@
 //! nothing), its views for the parallel pass, and [`CHANNELS`], the table that the checkpoint's datasets, the restart
 //! comparison and the reference digests are built from.
 //!
-//! Adding a channel is one line in the declaration plus the kernel that fills it. Today's channels are totals over
-//! the run (the contact statistics of `output.contact_statistics`), part of the state and checkpointed.
+//! Adding a channel is one line in the declaration plus the kernel that fills it. Each channel belongs to a
+//! [`ChannelGroup`] that a run switches on as a whole: the contact statistics of `output.contact_statistics` (totals
+//! over the run, part of the state and checkpointed) and heat (the conduction into each particle during one step,
+//! consumed by the particle's temperature update in the same pass and so zero between steps).
 
 /// How particle j of a pair receives what a kernel gives particle i.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -21,10 +23,41 @@ pub enum Partner {
     Opposite,
 }
 
+/// The groups of channels a run switches on or off together.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum ChannelGroup {
+    /// Contact counts and durations (`output.contact_statistics`).
+    Statistics,
+    /// Heat flowing into each particle by conduction this step (a run with `heat`).
+    Heat,
+}
+
+/// Which groups a run records.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct ChannelGroups {
+    pub statistics: bool,
+    pub heat: bool,
+}
+
+impl ChannelGroups {
+    pub const NONE: ChannelGroups = ChannelGroups {
+        statistics: false,
+        heat: false,
+    };
+
+    pub fn has(&self, group: ChannelGroup) -> bool {
+        match group {
+            ChannelGroup::Statistics => self.statistics,
+            ChannelGroup::Heat => self.heat,
+        }
+    }
+}
+
 /// One channel, for the generic walkers (checkpoint, restart comparison, digests).
 #[derive(Debug, Clone, Copy)]
 pub struct ChannelInfo {
     pub name: &'static str,
+    pub group: ChannelGroup,
     pub unit: &'static str,
     pub doc: &'static str,
     pub partner: Partner,
@@ -36,7 +69,7 @@ pub struct ChannelInfo {
 
 /// Declares the channels; see the module documentation for what it generates.
 macro_rules! scalar_channels {
-    ($( $(#[$doc:meta])* $name:ident: $unit:literal, $partner:ident, $text:literal; )*) => {
+    ($( $(#[$doc:meta])* $name:ident: $unit:literal, $partner:ident, $group:ident, $text:literal; )*) => {
         /// One contact's contributions to every channel, for particle i.
         #[derive(Debug, Clone, Copy, PartialEq, Default)]
         pub struct ScalarFlows {
@@ -62,7 +95,7 @@ macro_rules! scalar_channels {
             }
         }
 
-        /// Every channel's value per particle (each column empty when the run does not record channels).
+        /// Every channel's value per particle (a column is empty when the run does not record its group).
         #[derive(Debug, Clone, Default, PartialEq)]
         pub struct ParticleChannels {
             $( $(#[$doc])* pub $name: Vec<f64>, )*
@@ -74,22 +107,27 @@ macro_rules! scalar_channels {
         }
 
         impl ParticleChannels {
-            /// Zeroed channels for `n` particles, or empty ones when `on` is false.
-            pub fn new(n: usize, on: bool) -> Self {
-                let len = if on { n } else { 0 };
-                ParticleChannels { $( $name: vec![0.0; len], )* }
+            /// Zeroed channels for `n` particles in the groups `on`, empty columns for the others.
+            pub fn new(n: usize, on: ChannelGroups) -> Self {
+                ParticleChannels { $( $name: vec![0.0; if on.has(ChannelGroup::$group) { n } else { 0 }], )* }
             }
 
-            /// A new particle's zero values, where the run records channels.
-            pub fn push_zero(&mut self) {
-                if self.is_on() {
-                    $( self.$name.push(0.0); )*
-                }
+            /// Which groups these channels record (a group is on when its columns are not empty; with no
+            /// particles, none is).
+            pub fn groups(&self) -> ChannelGroups {
+                let mut on = ChannelGroups::NONE;
+                $( if !self.$name.is_empty() {
+                    match ChannelGroup::$group {
+                        ChannelGroup::Statistics => on.statistics = true,
+                        ChannelGroup::Heat => on.heat = true,
+                    }
+                } )*
+                on
             }
 
-            /// Whether the run records channels.
+            /// Whether the run records any channel.
             pub fn is_on(&self) -> bool {
-                true $( && !self.$name.is_empty() )*
+                false $( || !self.$name.is_empty() )*
             }
 
             pub fn view(&mut self) -> ChannelsMut<'_> {
@@ -115,10 +153,13 @@ macro_rules! scalar_channels {
                 ChannelsMut { $( $name: self.$name, )* }
             }
 
-            /// Adds `flows` to particle i (local to the view).
+            /// Adds `flows` to particle i (local to the view), in the columns the run records (the test is the
+            /// bounds check indexing would make anyway).
             #[inline(always)]
             pub fn add(&mut self, i: usize, flows: &ScalarFlows) {
-                $( self.$name[i] += flows.$name; )*
+                $( if let Some(value) = self.$name.get_mut(i) {
+                    *value += flows.$name;
+                } )*
             }
         }
 
@@ -126,6 +167,7 @@ macro_rules! scalar_channels {
         pub const CHANNELS: &[ChannelInfo] = &[$(
             ChannelInfo {
                 name: stringify!($name),
+                group: ChannelGroup::$group,
                 unit: $unit,
                 doc: $text,
                 partner: Partner::$partner,
@@ -139,15 +181,18 @@ macro_rules! scalar_channels {
 
 scalar_channels! {
     /// Particle–particle contacts of this particle that have ended (each counted on both particles).
-    contacts_ended: "1", Same, "particle-particle contacts ended (counted on both particles)";
+    contacts_ended: "1", Same, Statistics, "particle-particle contacts ended (counted on both particles)";
     /// Their summed durations, s (the contact slot's `duration_s` when the contact ended).
-    contact_time_ended_s: "s", Same, "summed duration of the ended particle-particle contacts";
+    contact_time_ended_s: "s", Same, Statistics, "summed duration of the ended particle-particle contacts";
     /// Wall contacts of this particle that have ended.
-    wall_contacts_ended: "1", Same, "wall contacts ended";
+    wall_contacts_ended: "1", Same, Statistics, "wall contacts ended";
     /// Their summed durations, s.
-    wall_contact_time_ended_s: "s", Same, "summed duration of the ended wall contacts";
+    wall_contact_time_ended_s: "s", Same, Statistics, "summed duration of the ended wall contacts";
     /// Time this particle has spent touching at least one wall, s.
-    wall_contact_time_s: "s", Same, "time spent touching at least one wall";
+    wall_contact_time_s: "s", Same, Statistics, "time spent touching at least one wall";
+    /// Heat flowing into this particle by conduction (contacts, walls, liquid bridges) during the current step, W:
+    /// summed by the pass and consumed by the particle's temperature update, so zero between steps.
+    heat_flow_w: "W", Opposite, Heat, "heat flowing in by conduction during the current step (zero between steps)";
 }
 
 /// Sum of `values` in index order.

@@ -2,8 +2,10 @@
 //! and engine types (built from the scenario by `scenario/build.rs`, which owns every unit conversion). The driver
 //! (`simulation.rs`) holds it behind an `Arc`; kernels read the parts they need.
 
+use super::channels::ChannelGroups;
 use super::cohesion::Cohesion;
 use super::geometry::{Domain, Gravity, Wall};
+use super::heat::HeatConfig;
 use super::models::history::HistoryLayout;
 use super::models::{ContactLaw, PairTable};
 use super::neighbor::Reach;
@@ -39,6 +41,8 @@ pub struct SimConfig {
     /// Record each contact's duration and the particles' contact statistics (`engine::channels`;
     /// `output.contact_statistics`).
     pub contact_statistics: bool,
+    /// Heat transfer (particle temperatures, conduction); `None`: no temperatures.
+    pub heat: Option<HeatConfig>,
 }
 
 impl SimConfig {
@@ -49,6 +53,14 @@ impl SimConfig {
             cohesion: self.cohesion.is_some(),
             contact_duration: self.contact_statistics,
             ..self.contact_law.history_layout()
+        }
+    }
+
+    /// The scalar channel groups the run records.
+    pub fn channel_groups(&self) -> ChannelGroups {
+        ChannelGroups {
+            statistics: self.contact_statistics,
+            heat: self.heat.is_some(),
         }
     }
 

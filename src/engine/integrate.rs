@@ -8,6 +8,7 @@
 
 use super::Vec3;
 use super::geometry::Domain;
+use super::heat::HeatConfig;
 use super::particles::Particles;
 use super::team::Team;
 
@@ -20,11 +21,14 @@ const CHUNK: usize = 2048;
 pub struct InverseInertia {
     pub inv_mass_per_kg: Vec<f64>,
     pub inv_inertia_per_kg_m2: Vec<f64>,
+    /// 1/(m c_p), the temperature step per joule, K/J (empty without heat transfer).
+    pub inv_thermal_mass_per_j_k: Vec<f64>,
 }
 
 impl InverseInertia {
-    pub fn new(p: &Particles, rotation: bool) -> Self {
+    pub fn new(p: &Particles, rotation: bool, heat: Option<&HeatConfig>) -> Self {
         InverseInertia {
+            inv_thermal_mass_per_j_k: heat.map_or_else(Vec::new, |h| h.inverse_thermal_mass(p)),
             inv_mass_per_kg: p.mass_kg.iter().map(|m| 1.0 / m).collect(),
             inv_inertia_per_kg_m2: p
                 .inertia_kg_m2

@@ -9,6 +9,7 @@ pub mod contacts;
 pub mod error;
 pub mod gas;
 pub mod geometry;
+pub mod heat;
 pub mod integrate;
 pub mod liquid;
 pub mod models;

@@ -25,10 +25,11 @@ use std::sync::atomic::Ordering;
 use std::time::Instant;
 
 use super::Vec3;
-use super::channels::{ChannelsMut, ParticleChannels, ScalarFlows};
+use super::channels::{ChannelGroups, ChannelsMut, ParticleChannels, ScalarFlows};
 use super::cohesion::{Bond, BridgeConstants, Cohesion};
 use super::contacts::{AlignedHistory, ColumnsMut, split_at_ends};
 use super::geometry::Wall;
+use super::heat::HeatConfig;
 use super::integrate::{InverseInertia, half_kick_one};
 use super::liquid::BridgeCache;
 use super::models::history::{CohesionHistory, HistoryLayout, StaticLayout};
@@ -46,12 +47,17 @@ pub trait PassKind: StaticLayout {
     /// The wide pass: the cohesion model's forces and the scalar channels, each where the run has them (checked
     /// once per slot at run time; the narrow pass has neither in its code).
     const WIDE: bool;
+    /// The pass may carry heat: the wide pass (where the run has heat), or the heat pass, which is the narrow one
+    /// plus conduction and the heat channel alone (a dry run with heat transfer: through the wide pass it cost
+    /// 1.27× the same run without heat, `docs/performance.md`).
+    const HEAT: bool;
 }
 
-/// The pass kinds: `WB` Walton-Braun history, `TH` Thornton history, `WIDE` cohesion forces and channels.
-pub struct Pass<const WB: bool, const TH: bool, const WIDE: bool>;
+/// The pass kinds: `WB` Walton-Braun history, `TH` Thornton history, `WIDE` cohesion forces and channels, `HEAT`
+/// (with `WIDE` false) conduction only.
+pub struct Pass<const WB: bool, const TH: bool, const WIDE: bool, const HEAT: bool>;
 
-impl<const WB: bool, const TH: bool, const WIDE: bool> StaticLayout for Pass<WB, TH, WIDE> {
+impl<const WB: bool, const TH: bool, const WIDE: bool, const HEAT: bool> StaticLayout for Pass<WB, TH, WIDE, HEAT> {
     const LAYOUT: HistoryLayout = HistoryLayout {
         tangential: true,
         walton_braun: WB,
@@ -62,8 +68,9 @@ impl<const WB: bool, const TH: bool, const WIDE: bool> StaticLayout for Pass<WB,
     };
 }
 
-impl<const WB: bool, const TH: bool, const WIDE: bool> PassKind for Pass<WB, TH, WIDE> {
+impl<const WB: bool, const TH: bool, const WIDE: bool, const HEAT: bool> PassKind for Pass<WB, TH, WIDE, HEAT> {
     const WIDE: bool = WIDE;
+    const HEAT: bool = WIDE || HEAT;
 }
 
 /// Per-slot results of cross-range pairs (multi-threaded path only).
@@ -168,12 +175,15 @@ trait Motion {
     fn x(&self, i: usize) -> Vec3;
     fn v(&self, i: usize) -> Vec3;
     fn w(&self, i: usize) -> Vec3;
+    /// Temperature, K (a run with heat transfer only).
+    fn t(&self, i: usize) -> f64;
 }
 
 struct Plain<'a> {
     x: &'a [Vec3],
     v: &'a [Vec3],
     w: &'a [Vec3],
+    t: &'a [f64],
 }
 
 impl Motion for Plain<'_> {
@@ -189,6 +199,10 @@ impl Motion for Plain<'_> {
     fn w(&self, i: usize) -> Vec3 {
         self.w[i]
     }
+    #[inline(always)]
+    fn t(&self, i: usize) -> f64 {
+        self.t[i]
+    }
 }
 
 /// Cells over a range of particles starting at `base` (0 for all particles), indexed by global particle index.
@@ -196,17 +210,24 @@ struct Cells<'a> {
     x: &'a [Cell<Vec3>],
     v: &'a [Cell<Vec3>],
     w: &'a [Cell<Vec3>],
+    t: &'a [Cell<f64>],
     base: usize,
 }
 
 impl<'a> Cells<'a> {
-    fn new(x: &'a mut [Vec3], v: &'a mut [Vec3], w: &'a mut [Vec3], base: usize) -> Self {
+    fn new(x: &'a mut [Vec3], v: &'a mut [Vec3], w: &'a mut [Vec3], t: &'a mut [f64], base: usize) -> Self {
         Cells {
             x: Cell::from_mut(x).as_slice_of_cells(),
             v: Cell::from_mut(v).as_slice_of_cells(),
             w: Cell::from_mut(w).as_slice_of_cells(),
+            t: Cell::from_mut(t).as_slice_of_cells(),
             base,
         }
+    }
+
+    #[inline(always)]
+    fn set_t(&self, i: usize, t: f64) {
+        self.t[i - self.base].set(t);
     }
 
     #[inline(always)]
@@ -229,6 +250,10 @@ impl Motion for Cells<'_> {
     #[inline(always)]
     fn w(&self, i: usize) -> Vec3 {
         self.w[i - self.base].get()
+    }
+    #[inline(always)]
+    fn t(&self, i: usize) -> f64 {
+        self.t[i - self.base].get()
     }
 }
 
@@ -258,9 +283,19 @@ struct Context<'a> {
     cohesion: Option<&'a Cohesion>,
     /// The constants of the standing liquid bridges, per slot of the whole list.
     bridges: &'a BridgeCache,
-    /// The run records the scalar channels (`engine::channels`) and the contacts' durations.
+    /// The run records scalar channels (`engine::channels`), of any group.
     channels: bool,
+    /// The run records the contact statistics (their channels and the contacts' durations).
+    statistics: bool,
+    /// Heat transfer: the conduction table and wall temperatures (the run then records the heat channel).
+    heat: Option<&'a HeatConfig>,
+    /// 1/(m c_p) per particle (heat transfer only).
+    inv_thermal_mass_per_j_k: &'a [f64],
 }
+
+/// Result of one wall slot: the contact's (force, torque) on i while it overlaps, the cohesion model's while it acts,
+/// and the slot's flows into i's channels.
+type WallSlotResult = (Option<(Vec3, Vec3)>, Option<(Vec3, Vec3)>, ScalarFlows);
 
 /// Result of one particle–particle slot: force on i, torques on i and j. (Its channel flows into i go to an
 /// out-parameter, which the narrow pass never writes: a larger result kept the hot loop's registers busier.)
@@ -297,7 +332,7 @@ impl<'a> Context<'a> {
         accumulators_zeroed: bool,
         cohesion: Option<&'a Cohesion>,
         bridges: &'a BridgeCache,
-        channels: bool,
+        channels: ChannelGroups,
     ) -> Self {
         Context {
             config,
@@ -315,7 +350,10 @@ impl<'a> Context<'a> {
             accumulators_zeroed,
             cohesion,
             bridges,
-            channels,
+            channels: channels != ChannelGroups::NONE,
+            statistics: channels.statistics,
+            heat: config.heat.as_ref().filter(|_| channels.heat),
+            inv_thermal_mass_per_j_k: &inverse.inv_thermal_mass_per_j_k,
         }
     }
 
@@ -323,7 +361,7 @@ impl<'a> Context<'a> {
     /// out of its slot, as the flows of an ended contact (`wall`: to a wall). `None` otherwise.
     #[inline(always)]
     fn contact_ended<P: PassKind>(&self, hist: &mut ColumnsMut, k: usize, wall: bool) -> Option<ScalarFlows> {
-        if !(P::WIDE && self.channels && hist.touching[k]) {
+        if !(P::WIDE && self.statistics && hist.touching[k]) {
             return None;
         }
         let duration_s = std::mem::replace(&mut hist.duration.duration_s[k], 0.0);
@@ -345,7 +383,7 @@ impl<'a> Context<'a> {
     /// Where the run records channels: slot `k` touches for one more step.
     #[inline(always)]
     fn contact_lasts<P: PassKind>(&self, hist: &mut ColumnsMut, k: usize) {
-        if P::WIDE && self.channels {
+        if P::WIDE && self.statistics {
             hist.duration.duration_s[k] += self.dt_s;
         }
     }
@@ -429,6 +467,17 @@ impl<'a> Context<'a> {
         let out = self.law.evaluate(mat, &kin, self.dt_s, &mut h);
         hist.save_as::<P>(k, &h);
         self.contact_lasts::<P>(hist, k);
+        if P::HEAT
+            && let Some(heat) = self.heat
+        {
+            // Q = H (T_j − T_i) into i (seed 000 eq. 5.3); j receives the opposite.
+            let conductance = heat.pair(bi.species, self.species[j]).conductance_w_per_k(
+                &self.law.normal,
+                &out,
+                kin.effective_radius_m,
+            );
+            flows.heat_flow_w = conductance * (vel.t(j) - vel.t(i));
+        }
         let nxft = n.cross(&out.tangential_force);
         let contact = PairResult {
             force: out.force,
@@ -506,6 +555,7 @@ impl<'a> Context<'a> {
         x: Vec3,
         vi: Vec3,
         wi: Vec3,
+        ti: f64,
         wall_ids: &[u16],
         hist: &mut ColumnsMut,
         first_slot: usize,
@@ -521,6 +571,7 @@ impl<'a> Context<'a> {
             // dry benchmark 4-7 % slower, although every wide branch is a compile-time `false` there
             // (`docs/performance.md`); the two must compute the same contact (tests/engine_reference.rs pins it).
             let ri = self.radius_m[i];
+            let mut heat_flow_w = 0.0;
             for (offset, &w) in wall_ids.iter().enumerate() {
                 let k = first_slot + offset;
                 let wall = &self.config.walls[w as usize];
@@ -547,17 +598,31 @@ impl<'a> Context<'a> {
                 hist.save_as::<P>(k, &h);
                 *f += out.force;
                 *t += -(n.cross(&out.tangential_force) * ri) + out.rolling_torque;
+                if P::HEAT
+                    && let Some(heat) = self.heat
+                    && let Some(wall_temperature_k) = heat.wall_temperature_k[w as usize]
+                {
+                    // As in `wall_slot`.
+                    let conductance =
+                        heat.pair(self.species[i], wall.species)
+                            .conductance_w_per_k(&self.law.normal, &out, ri);
+                    heat_flow_w += conductance * (wall_temperature_k - ti);
+                }
             }
-            return ScalarFlows::ZERO;
+            return ScalarFlows {
+                heat_flow_w,
+                ..ScalarFlows::ZERO
+            };
         }
         let mut flows = ScalarFlows::ZERO;
         let mut touches_a_wall = false;
         for (offset, &w) in wall_ids.iter().enumerate() {
-            let (contact, bond, ended) = self.wall_slot::<P>(
+            let (contact, bond, slot_flows) = self.wall_slot::<P>(
                 i,
                 x,
                 vi,
                 wi,
+                ti,
                 w,
                 hist,
                 first_slot + offset,
@@ -575,12 +640,10 @@ impl<'a> Context<'a> {
                     *f += force;
                     *t += torque;
                 }
-                if let Some(ended) = ended {
-                    flows.add(&ended);
-                }
+                flows.add(&slot_flows);
             }
         }
-        if P::WIDE && self.channels && touches_a_wall {
+        if P::WIDE && self.statistics && touches_a_wall {
             flows.wall_contact_time_s += self.dt_s;
         }
         flows
@@ -598,20 +661,23 @@ impl<'a> Context<'a> {
         x: Vec3,
         vi: Vec3,
         wi: Vec3,
+        ti: f64,
         w: u16,
         hist: &mut ColumnsMut,
         k: usize,
         slot: usize,
         worst: &mut WorstOverlap,
         crossings: &mut u64,
-    ) -> (Option<(Vec3, Vec3)>, Option<(Vec3, Vec3)>, Option<ScalarFlows>) {
+    ) -> WallSlotResult {
         let ri = self.radius_m[i];
         let wall = &self.config.walls[w as usize];
         let prox = wall.proximity(&x, self.wall_angle[w as usize]);
         let overlap = ri - prox.gap_m;
-        let mut ended = None;
+        let mut flows = ScalarFlows::ZERO;
         let contact = if overlap <= 0.0 {
-            ended = self.contact_ended::<P>(hist, k, true);
+            if let Some(ended) = self.contact_ended::<P>(hist, k, true) {
+                flows = ended;
+            }
             hist.release_as::<P>(k);
             None
         } else {
@@ -631,21 +697,32 @@ impl<'a> Context<'a> {
             let out = self.law.evaluate(mat, &kin, self.dt_s, &mut h);
             hist.save_as::<P>(k, &h);
             self.contact_lasts::<P>(hist, k);
+            if P::HEAT
+                && let Some(heat) = self.heat
+                && let Some(wall_temperature_k) = heat.wall_temperature_k[w as usize]
+            {
+                // The wall an infinite particle at its own temperature (seed 000 §5.1.2.1); adiabatic walls pass
+                // nothing.
+                let conductance =
+                    heat.pair(self.species[i], wall.species)
+                        .conductance_w_per_k(&self.law.normal, &out, ri);
+                flows.heat_flow_w = conductance * (wall_temperature_k - ti);
+            }
             Some((out.force, -(n.cross(&out.tangential_force) * ri) + out.rolling_torque))
         };
         if !P::WIDE {
-            return (contact, None, None);
+            return (contact, None, flows);
         }
         let Some(c) = self
             .cohesion
             .filter(|c| c.wall_range_m > 0.0 && c.wall_on.get(w as usize).copied().unwrap_or(true))
         else {
-            return (contact, None, ended);
+            return (contact, None, flows);
         };
         let gap = prox.gap_m - ri;
         let mut state = cohesion_state(hist, k);
         if gap >= c.wall_range_m && state.is_empty() {
-            return (contact, None, ended);
+            return (contact, None, flows);
         }
         let n = prox.normal;
         let bond = Bond {
@@ -664,12 +741,13 @@ impl<'a> Context<'a> {
         hist.cohesion.in_well[k] = state.in_well;
         *crossings += u64::from(out.crossed_well);
         let force = n * out.normal_n + out.tangential_n;
-        (contact, Some((force, -(n.cross(&out.tangential_n) * ri))), ended)
+        (contact, Some((force, -(n.cross(&out.tangential_n) * ri))), flows)
     }
 
     /// Completes particle i once all its pair contributions are in (f, t): its walls, then [`Context::finish`],
     /// storing the new motion. `wall_ids` are i's walls, whose history is in `walls` from `first_wall_slot` on (slot
-    /// `first_wall_slot_global` of the whole list). Returns the final (f, t) and the walls' flows into i's channels.
+    /// `first_wall_slot_global` of the whole list). Adds the walls' flows to i's channels and, with heat transfer,
+    /// advances i's temperature by the step's conduction. Returns the final (f, t).
     #[allow(clippy::too_many_arguments)]
     #[inline(always)]
     fn complete<P: PassKind>(
@@ -682,14 +760,21 @@ impl<'a> Context<'a> {
         walls: &mut ColumnsMut,
         first_wall_slot: usize,
         first_wall_slot_global: usize,
+        channels: &mut ChannelsMut,
         tally: &mut Tally,
-    ) -> (Vec3, Vec3, ScalarFlows) {
+    ) -> (Vec3, Vec3) {
         let (xi, vi, wi) = (motion.x(i), motion.v(i), motion.w(i));
+        let ti = if P::HEAT && self.heat.is_some() {
+            motion.t(i)
+        } else {
+            0.0
+        };
         let flows = self.walls::<P>(
             i,
             xi,
             vi,
             wi,
+            ti,
             wall_ids,
             walls,
             first_wall_slot,
@@ -699,15 +784,28 @@ impl<'a> Context<'a> {
             &mut tally.worst,
             &mut tally.well_crossings,
         );
+        if P::WIDE && self.channels {
+            channels.add(i, &flows);
+        } else if P::HEAT && self.heat.is_some() {
+            channels.heat_flow_w[i] += flows.heat_flow_w;
+        }
+        if P::HEAT && self.heat.is_some() {
+            // All of i's conduction is in: one explicit step of m c_p dT/dt = Q (seed 000 eq. 5.2), the channel
+            // left zero for the next step. The pass that only computes the initial forces (no kick) moves nothing.
+            let heat_flow_w = std::mem::replace(&mut channels.heat_flow_w[i], 0.0);
+            if self.kick.is_some() {
+                motion.set_t(i, ti + self.dt_s * heat_flow_w * self.inv_thermal_mass_per_j_k[i]);
+            }
+        }
         let (x_new, v_new, w_new, d2) = self.finish(i, &mut f, &mut t, xi, vi, wi);
         tally.velocity_sum += (v_new.x + v_new.y + v_new.z) + (w_new.x + w_new.y + w_new.z);
         tally.max_displacement2 = tally.max_displacement2.max(d2);
         motion.set(i, x_new, v_new, w_new);
         if self.kick.is_some_and(|k| k.fuse_next_drift) {
             // The next step's pass accumulates into these arrays: leave them zero (see `compute_pair_forces`).
-            (Vec3::zeros(), Vec3::zeros(), flows)
+            (Vec3::zeros(), Vec3::zeros())
         } else {
-            (f, t, flows)
+            (f, t)
         }
     }
 
@@ -856,6 +954,7 @@ pub fn compute_pair_forces(
     let mut position = std::mem::take(&mut p.position_m);
     let mut velocity = std::mem::take(&mut p.velocity_m_per_s);
     let mut omega = std::mem::take(&mut p.angular_velocity_rad_per_s);
+    let mut temperature = std::mem::take(&mut p.temperature_k);
     let mut channels = std::mem::take(&mut p.channels);
     let channels_on = channels.is_on();
     let reference = if list.reference_positions().len() == position.len() {
@@ -874,15 +973,18 @@ pub fn compute_pair_forces(
         accumulators_zeroed,
         cohesion,
         bridges,
-        channels_on,
+        channels.groups(),
     );
     // One instantiation per pass kind: the layout decides which history fields exist, and knowing it at compile
     // time lets the kernels' unused fields vanish from the loop; a dry run has no cohesion code in it.
     let layout = config.contact_law.history_layout();
     macro_rules! run {
         ($wb:literal, $th:literal, $co:literal) => {
+            run!($wb, $th, $co, false)
+        };
+        ($wb:literal, $th:literal, $co:literal, $heat:literal) => {
             if team.size() == 1 || plan.bounds.len() <= 2 {
-                serial::<Pass<$wb, $th, $co>>(
+                serial::<Pass<$wb, $th, $co, $heat>>(
                     &ctx,
                     list,
                     history,
@@ -891,10 +993,11 @@ pub fn compute_pair_forces(
                     &mut position,
                     &mut velocity,
                     &mut omega,
+                    &mut temperature,
                     &mut channels,
                 )
             } else {
-                parallel::<Pass<$wb, $th, $co>>(
+                parallel::<Pass<$wb, $th, $co, $heat>>(
                     &ctx,
                     list,
                     history,
@@ -904,6 +1007,7 @@ pub fn compute_pair_forces(
                     &mut position,
                     &mut velocity,
                     &mut omega,
+                    &mut temperature,
                     &mut channels,
                     plan,
                     team,
@@ -911,7 +1015,13 @@ pub fn compute_pair_forces(
             }
         };
     }
-    let pass = match (layout.walton_braun, layout.thornton, cohesion.is_some() || channels_on) {
+    // A run whose only channel is heat, with a contact law without Walton-Braun's or Thornton's history (the kiln,
+    // the drums), takes the heat pass; any other run with heat the wide one.
+    let groups = channels.groups();
+    let heat_only = groups.heat && !groups.statistics && cohesion.is_none();
+    let wide = cohesion.is_some() || channels_on;
+    let pass = match (layout.walton_braun, layout.thornton, wide) {
+        (false, false, true) if heat_only => run!(false, false, false, true),
         (false, false, false) => run!(false, false, false),
         (true, false, false) => run!(true, false, false),
         (false, true, false) => run!(false, true, false),
@@ -926,6 +1036,7 @@ pub fn compute_pair_forces(
     p.position_m = position;
     p.velocity_m_per_s = velocity;
     p.angular_velocity_rad_per_s = omega;
+    p.temperature_k = temperature;
     p.channels = channels;
     pass
 }
@@ -960,12 +1071,13 @@ pub fn add_wall_forces(
         false,
         cohesion,
         bridges,
-        false,
+        ChannelGroups::NONE,
     );
     let motion = Plain {
         x: &p.position_m,
         v: &p.velocity_m_per_s,
         w: &p.angular_velocity_rad_per_s,
+        t: &p.temperature_k,
     };
     let mut scratch = history.wall.clone();
     let layout = config.contact_law.history_layout();
@@ -976,11 +1088,12 @@ pub fn add_wall_forces(
             for i in 0..p.len() {
                 for k in list.walls_of(i) {
                     let wall = list.wall_partner[k];
-                    let (contact, bond, _) = ctx.wall_slot::<Pass<$wb, $th, $co>>(
+                    let (contact, bond, _) = ctx.wall_slot::<Pass<$wb, $th, $co, false>>(
                         i,
                         motion.x(i),
                         motion.v(i),
                         motion.w(i),
+                        0.0,
                         wall,
                         &mut walls,
                         k,
@@ -1020,6 +1133,7 @@ fn serial<P: PassKind>(
     position: &mut [Vec3],
     velocity: &mut [Vec3],
     omega: &mut [Vec3],
+    temperature: &mut [f64],
     channels: &mut ParticleChannels,
 ) -> ForcePass {
     let ctx = *ctx;
@@ -1029,7 +1143,7 @@ fn serial<P: PassKind>(
         torque.fill(Vec3::zeros());
     }
     let window = ListWindow::new(list, 0, n);
-    let motion = (&mut *position, &mut *velocity, &mut *omega);
+    let motion = (&mut *position, &mut *velocity, &mut *omega, temperature);
     let no_buffers = PairBuffers::default();
     let (pairs, walls) = (history.pair.view(), history.wall.view());
     let tally = sweep::<P, false>(
@@ -1073,6 +1187,7 @@ fn parallel<P: PassKind>(
     position: &mut [Vec3],
     velocity: &mut [Vec3],
     omega: &mut [Vec3],
+    temperature: &mut [f64],
     channels: &mut ParticleChannels,
     plan: &RangePlan,
     team: &Team,
@@ -1102,6 +1217,7 @@ fn parallel<P: PassKind>(
             x: position,
             v: velocity,
             w: omega,
+            t: temperature,
         };
         let parts: Vec<_> = hist_parts
             .into_iter()
@@ -1146,7 +1262,7 @@ fn parallel<P: PassKind>(
                         }
                         None => onb[local] = false,
                     }
-                    if P::WIDE && ctx.channels {
+                    if P::HEAT && ctx.channels {
                         sb[local] = flows;
                     }
                 }
@@ -1166,17 +1282,22 @@ fn parallel<P: PassKind>(
     let x_parts = split_at_ends(position, particle_ends);
     let v_parts = split_at_ends(velocity, particle_ends);
     let w_parts = split_at_ends(omega, particle_ends);
+    let temperature_parts = split_at_ends(temperature, particle_ends);
     let channel_parts = channels.split(particle_ends);
     let parts: Vec<_> = f_parts
         .into_iter()
         .zip(t_parts)
-        .zip(x_parts.into_iter().zip(v_parts.into_iter().zip(w_parts)))
+        .zip(
+            x_parts
+                .into_iter()
+                .zip(v_parts.into_iter().zip(w_parts.into_iter().zip(temperature_parts))),
+        )
         .zip(hist_parts.into_iter().zip(wall_parts.into_iter().zip(channel_parts)))
         .collect();
     let (worst_ranges, non_finite, max_d2, crossings_ranges) = team
         .map_parts(
             parts,
-            |r, (((force, torque), (x, (v, w))), (pairs, (walls, channels)))| {
+            |r, (((force, torque), (x, (v, (w, temperature)))), (pairs, (walls, channels)))| {
                 let started = Instant::now();
                 let range = RangeData {
                     ctx,
@@ -1196,9 +1317,7 @@ fn parallel<P: PassKind>(
                     force,
                     torque,
                     channels,
-                    x,
-                    v,
-                    w,
+                    (x, v, w, temperature),
                     pairs,
                     walls,
                 );
@@ -1236,7 +1355,7 @@ fn sweep<P: PassKind, const CROSS: bool>(
     window: &ListWindow,
     lo: usize,
     particles: std::ops::Range<usize>,
-    motion: (&mut [Vec3], &mut [Vec3], &mut [Vec3]),
+    motion: Motion4,
     force: &mut [Vec3],
     torque: &mut [Vec3],
     channels: ChannelsMut,
@@ -1267,7 +1386,7 @@ fn sweep_x86_64_v3<P: PassKind, const CROSS: bool>(
     window: &ListWindow,
     lo: usize,
     particles: std::ops::Range<usize>,
-    motion: (&mut [Vec3], &mut [Vec3], &mut [Vec3]),
+    motion: Motion4,
     force: &mut [Vec3],
     torque: &mut [Vec3],
     channels: ChannelsMut,
@@ -1280,6 +1399,9 @@ fn sweep_x86_64_v3<P: PassKind, const CROSS: bool>(
     )
 }
 
+/// Positions, velocities, angular velocities and temperatures (empty without heat) of the particles a sweep moves.
+type Motion4<'a> = (&'a mut [Vec3], &'a mut [Vec3], &'a mut [Vec3], &'a mut [f64]);
+
 /// The loop of [`sweep`], inlined into each of its compilations.
 #[allow(clippy::too_many_arguments)]
 #[inline(always)]
@@ -1288,7 +1410,7 @@ fn sweep_body<P: PassKind, const CROSS: bool>(
     window: &ListWindow,
     lo: usize,
     particles: std::ops::Range<usize>,
-    (x, v, w): (&mut [Vec3], &mut [Vec3], &mut [Vec3]),
+    (x, v, w, temperature): Motion4,
     force: &mut [Vec3],
     torque: &mut [Vec3],
     mut channels: ChannelsMut,
@@ -1298,7 +1420,9 @@ fn sweep_body<P: PassKind, const CROSS: bool>(
 ) -> Tally {
     // Everything the loop touches is a local or a parameter slice (not reached through a reference to a struct),
     // which lets the compiler keep the slices' pointers in registers across the stores to `force`.
-    let motion = &Cells::new(x, v, w, 0);
+    // A pass without heat never reads temperatures: an empty slice keeps its pointer out of the loop.
+    let temperature = if P::HEAT { temperature } else { &mut [] };
+    let motion = &Cells::new(x, v, w, temperature, 0);
     let (pairs, walls) = (&mut pairs, &mut walls);
     let local_hi = force.len();
     let mut tally = Tally::default();
@@ -1330,6 +1454,9 @@ fn sweep_body<P: PassKind, const CROSS: bool>(
                 if P::WIDE && ctx.channels {
                     channels.add(il, &flows);
                     channels.add(j, &flows.for_partner());
+                } else if P::HEAT && ctx.heat.is_some() {
+                    channels.heat_flow_w[il] += flows.heat_flow_w;
+                    channels.heat_flow_w[j] -= flows.heat_flow_w;
                 }
             } else {
                 let k = k + window.pair_base;
@@ -1339,11 +1466,13 @@ fn sweep_body<P: PassKind, const CROSS: bool>(
                 }
                 if P::WIDE && ctx.channels {
                     channels.add(il, &buffers.scalars_on_i[k]);
+                } else if P::HEAT && ctx.heat.is_some() {
+                    channels.heat_flow_w[il] += buffers.scalars_on_i[k].heat_flow_w;
                 }
             }
         }
         let wall_slots = window.walls_of(il);
-        let (f, t, flows) = ctx.complete::<P>(
+        let (f, t) = ctx.complete::<P>(
             il,
             force[il],
             torque[il],
@@ -1352,13 +1481,11 @@ fn sweep_body<P: PassKind, const CROSS: bool>(
             walls,
             wall_slots.start,
             wall_slots.start + window.wall_base,
+            &mut channels,
             &mut tally,
         );
         force[il] = f;
         torque[il] = t;
-        if P::WIDE && ctx.channels {
-            channels.add(il, &flows);
-        }
     }
     tally
 }
@@ -1431,9 +1558,7 @@ fn range_sweep<P: PassKind>(
     force: &mut [Vec3],
     torque: &mut [Vec3],
     mut channels: ChannelsMut,
-    x: &mut [Vec3],
-    v: &mut [Vec3],
-    w: &mut [Vec3],
+    (x, v, w, temperature): Motion4,
     mut pairs: ColumnsMut,
     mut walls: ColumnsMut,
 ) -> (WorstOverlap, Option<usize>, f64, u64) {
@@ -1451,6 +1576,7 @@ fn range_sweep<P: PassKind>(
         inv_mass_per_kg: &outer.inv_mass_per_kg[lo..hi],
         inv_inertia_per_kg_m2: &outer.inv_inertia_per_kg_m2[lo..hi],
         reference: outer.reference.get(lo..hi).unwrap_or(&[]),
+        inv_thermal_mass_per_j_k: outer.inv_thermal_mass_per_j_k.get(lo..hi).unwrap_or(&[]),
         ..*outer
     };
     let window = ListWindow::new(list, lo, hi);
@@ -1467,11 +1593,13 @@ fn range_sweep<P: PassKind>(
         }
         if P::WIDE && ctx.channels {
             channels.add(j, &buffers.scalars_on_i[k].for_partner());
+        } else if P::HEAT && ctx.heat.is_some() {
+            channels.heat_flow_w[j] -= buffers.scalars_on_i[k].heat_flow_w;
         }
     }
     let local_hi = hi - lo;
     let cross_from = plan.cross_from[r] - lo;
-    let interior = (&mut *x, &mut *v, &mut *w);
+    let interior = (&mut *x, &mut *v, &mut *w, &mut *temperature);
     let (interior_pairs, interior_walls) = (pairs.reborrow(), walls.reborrow());
     let mut tally = sweep::<P, false>(
         ctx,
@@ -1491,7 +1619,7 @@ fn range_sweep<P: PassKind>(
         &window,
         lo,
         cross_from..local_hi,
-        (x, v, w),
+        (x, v, w, temperature),
         force,
         torque,
         channels,

@@ -52,6 +52,13 @@ pub struct Species {
     pub contact_angle_rad: f64,
     /// Liquid each particle of this species carries at the start, as V̂ = V/R³.
     pub liquid_content: f64,
+    /// The real material's Young's modulus where `youngs_modulus_pa` is softened (heat conduction's contact radius
+    /// correction), Pa.
+    pub real_youngs_modulus_pa: Option<f64>,
+    /// Solid thermal conductivity k_s, W/(m K).
+    pub thermal_conductivity_w_per_m_k: Option<f64>,
+    /// Specific heat capacity c_p, J/(kg K).
+    pub heat_capacity_j_per_kg_k: Option<f64>,
 }
 
 impl Species {
@@ -76,6 +83,9 @@ impl Species {
             rolling_friction_coefficient: 0.0,
             contact_angle_rad: 0.0,
             liquid_content: 0.0,
+            real_youngs_modulus_pa: None,
+            thermal_conductivity_w_per_m_k: None,
+            heat_capacity_j_per_kg_k: None,
         }
     }
 }
@@ -127,6 +137,8 @@ pub struct Particles {
     pub liquid_m3: Vec<f64>,
     /// Liquid the particle has received from the spray since the start, m³ (for the coating variability CV_m).
     pub sprayed_m3: Vec<f64>,
+    /// Temperature of each (lumped) particle, K; empty in a run without heat transfer (`engine::heat`).
+    pub temperature_k: Vec<f64>,
     /// The scalar channels the pair pass adds into (`engine::channels`; empty columns when the run records none).
     pub channels: ParticleChannels,
 }
@@ -156,7 +168,6 @@ impl Particles {
         self.torque_n_m.push(Vec3::zeros());
         self.liquid_m3.push(species.liquid_content * radius_m.powi(3));
         self.sprayed_m3.push(0.0);
-        self.channels.push_zero();
         id
     }
 
@@ -190,7 +201,8 @@ impl Particles {
                 + self.mass_kg.capacity()
                 + self.inertia_kg_m2.capacity()
                 + self.liquid_m3.capacity()
-                + self.sprayed_m3.capacity())
+                + self.sprayed_m3.capacity()
+                + self.temperature_k.capacity())
                 * 8
             + (self.position_m.capacity()
                 + self.velocity_m_per_s.capacity()

@@ -143,7 +143,7 @@ impl Simulation {
         threads: usize,
     ) -> Result<Self, NumericalError> {
         let n_walls = config.walls.len();
-        let inverse = InverseInertia::new(&particles, config.rotation);
+        let inverse = InverseInertia::new(&particles, config.rotation, config.heat.as_ref());
         let mut sim = Simulation {
             config,
             particles,
@@ -171,7 +171,7 @@ impl Simulation {
 
     /// Resumes from a checkpointed state; the next `step()` continues exactly where the saved run was.
     pub fn restore(config: Arc<SimConfig>, state: SimState, threads: usize) -> Result<Self, NumericalError> {
-        let inverse = InverseInertia::new(&state.particles, config.rotation);
+        let inverse = InverseInertia::new(&state.particles, config.rotation, config.heat.as_ref());
         let mut sim = Simulation {
             config,
             particles: state.particles,
@@ -425,6 +425,20 @@ impl Simulation {
                 // The arrays were zero: they hold exactly the gas's forces.
                 tally.fluid_n += p.force_n.iter().fold(Vec3::zeros(), |sum, f| sum + f);
             }
+            self.timers.fluid_forces += t.elapsed();
+        }
+        if let Some(gas) = self.gas.as_mut().filter(|g| g.heat.is_some()) {
+            // Convection under the frozen gas field into the heat channel (zero here: the last pass consumed it),
+            // which the pair pass completes with conduction and turns into each particle's temperature step.
+            let t = Instant::now();
+            let p = &mut self.particles;
+            gas.add_convection(
+                &p.position_m,
+                &p.velocity_m_per_s,
+                &p.radius_m,
+                &p.temperature_k,
+                &mut p.channels.heat_flow_w,
+            );
             self.timers.fluid_forces += t.elapsed();
         }
         self.step_liquid(dt);

@@ -259,6 +259,7 @@ pub fn first_difference(a: &SimState, b: &SimState) -> Option<String> {
         })
         .or_else(|| scalars("particles.liquid_m3", &p.liquid_m3, &q.liquid_m3))
         .or_else(|| scalars("particles.sprayed_m3", &p.sprayed_m3, &q.sprayed_m3))
+        .or_else(|| scalars("particles.temperature_k", &p.temperature_k, &q.temperature_k))
         .or_else(|| {
             CHANNELS
                 .iter()

@@ -95,25 +95,15 @@ pub fn build(spec: ScenarioSpec, path: &Path) -> Result<BuiltScenario, ConfigErr
     if spec.species.is_empty() {
         return Err(c.fail("species", "expected at least one species"));
     }
+    let mut engine_species = Vec::with_capacity(spec.species.len());
     for (k, s) in spec.species.iter().enumerate() {
-        let key = |f: &str| format!("species[{k}].{f}");
-        c.positive(&key("radius_m"), s.radius_m)?;
-        c.positive(&key("density_kg_per_m3"), s.density_kg_per_m3)?;
-        c.positive(&key("youngs_modulus_pa"), s.youngs_modulus_pa)?;
-        if !(s.poisson_ratio.is_finite() && (0.0..0.5).contains(&s.poisson_ratio)) {
+        if spec.species[..k].iter().any(|o| o.name == s.name) {
             return Err(c.fail(
-                key("poisson_ratio"),
-                format!("expected 0 <= ν < 0.5, got {}", s.poisson_ratio),
+                format!("species[{k}].name"),
+                format!("species name '{}' is used twice", s.name),
             ));
         }
-        c.non_negative(&key("friction_coefficient"), s.friction_coefficient)?;
-        c.non_negative(&key("rolling_friction_coefficient"), s.rolling_friction_coefficient)?;
-        if let Some(fy) = s.yield_force_n {
-            c.positive(&key("yield_force_n"), fy)?;
-        }
-        if spec.species[..k].iter().any(|o| o.name == s.name) {
-            return Err(c.fail(key("name"), format!("species name '{}' is used twice", s.name)));
-        }
+        engine_species.push(resolve_species(&c, k, s)?);
     }
     if matches!(spec.cohesion, Some(CohesionModel::LiquidBridge(_))) {
         for (k, s) in spec.species.iter().enumerate() {
@@ -133,7 +123,7 @@ pub fn build(spec: ScenarioSpec, path: &Path) -> Result<BuiltScenario, ConfigErr
         }
     }
     let species = SpeciesTable {
-        species: spec.species.iter().map(engine_species).collect(),
+        species: engine_species,
     };
 
     check_contact_law(&c, &spec.contact)?;
@@ -164,8 +154,7 @@ pub fn build(spec: ScenarioSpec, path: &Path) -> Result<BuiltScenario, ConfigErr
     check_memory(&c, &spec)?;
     let walls = build_walls(&c, &spec, &species, &domain)?;
     let mut rng = RngState::from_seed_u64(spec.seed).restore();
-    let mut particles = fill(&c, &spec, &species, &domain, &walls, &mut rng)?;
-    particles.channels = ParticleChannels::new(particles.len(), spec.output.contact_statistics);
+    let (mut particles, fill_ends) = fill(&c, &spec, &species, &domain, &walls, &mut rng)?;
 
     let skin_m = spec.neighbor.skin_m.unwrap_or(0.4 * particles.max_radius_m());
     c.positive("neighbor.skin_m", skin_m)?;
@@ -238,8 +227,18 @@ pub fn build(spec: ScenarioSpec, path: &Path) -> Result<BuiltScenario, ConfigErr
     };
 
     check_step_reach(&c, &spec, &particles, dt_s)?;
+    let heat = super::heat::build_heat(
+        path,
+        &spec,
+        &species,
+        &walls,
+        &pair_table,
+        &fill_ends,
+        &mut particles,
+        dt_s,
+    )?;
 
-    let gas = match &spec.gas {
+    let mut gas = match &spec.gas {
         None => None,
         Some(g) => {
             if spec.gravity.flip.is_some() {
@@ -257,6 +256,13 @@ pub fn build(spec: ScenarioSpec, path: &Path) -> Result<BuiltScenario, ConfigErr
             )?)
         }
     };
+    if spec.gas.as_ref().is_some_and(|g| g.vacuum) {
+        // Checked as written, then switched off: the particles move in vacuum.
+        gas = None;
+    }
+    if let Some(g) = gas.as_mut() {
+        super::heat::build_gas_heat(path, &spec, g)?;
+    }
     let wall_species: Vec<_> = walls.iter().map(|w| w.species).collect();
     let mut cohesion = match spec.cohesion {
         None => None,
@@ -309,7 +315,9 @@ pub fn build(spec: ScenarioSpec, path: &Path) -> Result<BuiltScenario, ConfigErr
         max_overlap_fraction: spec.max_overlap_fraction,
         cohesion,
         contact_statistics: spec.output.contact_statistics,
+        heat,
     };
+    particles.channels = ParticleChannels::new(particles.len(), config.channel_groups());
     Ok(BuiltScenario {
         rng: RngState::capture(&rng),
         spec,
@@ -321,20 +329,84 @@ pub fn build(spec: ScenarioSpec, path: &Path) -> Result<BuiltScenario, ConfigErr
     })
 }
 
-/// The engine's species from the scenario's: SI units (the contact angle in radians).
-fn engine_species(s: &SpeciesSpec) -> Species {
-    Species {
+/// The engine's species from the scenario's entry `k`: the named material's properties where the entry gives
+/// none, each checked at its key, in SI units (the contact angle in radians).
+fn resolve_species(c: &Checker, k: usize, s: &SpeciesSpec) -> Result<Species, ConfigError> {
+    let key = |f: &str| format!("species[{k}].{f}");
+    let material = s.material.map(|m| m.properties());
+    let required = |field: &str, given: Option<f64>, from_material: Option<f64>| {
+        given.or(from_material).ok_or_else(|| {
+            c.fail(
+                key(field),
+                format!("expected `{field}` (or a `material` that gives it: glass, steel, aluminium)"),
+            )
+        })
+    };
+    let density_kg_per_m3 = required(
+        "density_kg_per_m3",
+        s.density_kg_per_m3,
+        material.map(|m| m.density_kg_per_m3),
+    )?;
+    let youngs_modulus_pa = required(
+        "youngs_modulus_pa",
+        s.youngs_modulus_pa,
+        material.map(|m| m.youngs_modulus_pa),
+    )?;
+    let poisson_ratio = required("poisson_ratio", s.poisson_ratio, material.map(|m| m.poisson_ratio))?;
+    let friction_coefficient = required(
+        "friction_coefficient",
+        s.friction_coefficient,
+        material.map(|m| m.friction_coefficient),
+    )?;
+    c.positive(&key("radius_m"), s.radius_m)?;
+    c.positive(&key("density_kg_per_m3"), density_kg_per_m3)?;
+    c.positive(&key("youngs_modulus_pa"), youngs_modulus_pa)?;
+    if !(poisson_ratio.is_finite() && (0.0..0.5).contains(&poisson_ratio)) {
+        return Err(c.fail(
+            key("poisson_ratio"),
+            format!("expected 0 <= ν < 0.5, got {poisson_ratio}"),
+        ));
+    }
+    c.non_negative(&key("friction_coefficient"), friction_coefficient)?;
+    c.non_negative(&key("rolling_friction_coefficient"), s.rolling_friction_coefficient)?;
+    if let Some(fy) = s.yield_force_n {
+        c.positive(&key("yield_force_n"), fy)?;
+    }
+    let real_youngs_modulus_pa = s.real_youngs_modulus_pa.or_else(|| {
+        material
+            .map(|m| m.youngs_modulus_pa)
+            .filter(|&e| e != youngs_modulus_pa)
+    });
+    if let Some(e) = real_youngs_modulus_pa {
+        c.positive(&key("real_youngs_modulus_pa"), e)?;
+    }
+    let thermal_conductivity_w_per_m_k = s
+        .thermal_conductivity_w_per_m_k
+        .or(material.map(|m| m.thermal_conductivity_w_per_m_k));
+    if let Some(k_s) = s.thermal_conductivity_w_per_m_k {
+        c.positive(&key("thermal_conductivity_w_per_m_k"), k_s)?;
+    }
+    let heat_capacity_j_per_kg_k = s
+        .heat_capacity_j_per_kg_k
+        .or(material.map(|m| m.heat_capacity_j_per_kg_k));
+    if let Some(c_p) = s.heat_capacity_j_per_kg_k {
+        c.positive(&key("heat_capacity_j_per_kg_k"), c_p)?;
+    }
+    Ok(Species {
         name: s.name.clone(),
         radius_m: s.radius_m,
-        density_kg_per_m3: s.density_kg_per_m3,
-        youngs_modulus_pa: s.youngs_modulus_pa,
-        poisson_ratio: s.poisson_ratio,
-        friction_coefficient: s.friction_coefficient,
+        density_kg_per_m3,
+        youngs_modulus_pa,
+        poisson_ratio,
+        friction_coefficient,
         yield_force_n: s.yield_force_n,
         rolling_friction_coefficient: s.rolling_friction_coefficient,
         contact_angle_rad: s.contact_angle_deg.to_radians(),
         liquid_content: s.liquid_content,
-    }
+        real_youngs_modulus_pa,
+        thermal_conductivity_w_per_m_k,
+        heat_capacity_j_per_kg_k,
+    })
 }
 
 /// The engine's gravity from the scenario's.
@@ -870,8 +942,9 @@ fn fill(
     domain: &Domain,
     walls: &[Wall],
     rng: &mut rand_chacha::ChaCha8Rng,
-) -> Result<Particles, ConfigError> {
+) -> Result<(Particles, Vec<usize>), ConfigError> {
     let mut particles = Particles::default();
+    let mut fill_ends = Vec::with_capacity(spec.fill.len());
     if spec.fill.is_empty() {
         return Err(c.fail("fill", "expected at least one fill entry"));
     }
@@ -885,6 +958,7 @@ fn fill(
                 origin_m,
                 inside_drum,
                 jitter_m,
+                temperature_k: _,
             } => {
                 let key = |f: &str| format!("fill[{k}].lattice.{f}");
                 let id = c.species(&key("species"), species, s)?;
@@ -962,6 +1036,7 @@ fn fill(
                 positions_m,
                 velocities_m_per_s,
                 angular_velocities_rad_per_s,
+                temperature_k: _,
             } => {
                 let key = |f: &str| format!("fill[{k}].explicit.{f}");
                 let id = c.species(&key("species"), species, s)?;
@@ -1018,6 +1093,7 @@ fn fill(
                 lo_m,
                 hi_m,
                 inside_drum,
+                temperature_k: _,
             } => {
                 let key = |f: &str| format!("fill[{k}].random.{f}");
                 let id = c.species(&key("species"), species, s)?;
@@ -1057,8 +1133,9 @@ fn fill(
                 }
             }
         }
+        fill_ends.push(particles.len());
     }
-    Ok(particles)
+    Ok((particles, fill_ends))
 }
 
 /// Random sequential insertion with rejection of overlaps (against all particles placed so far).

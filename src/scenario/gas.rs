@@ -9,10 +9,12 @@ use serde::{Deserialize, Serialize};
 
 use super::ConfigError;
 use crate::engine::Vec3;
+use crate::engine::gas::GasScalarSpec;
 use crate::engine::gas::coupled::GasCoupling;
 use crate::engine::gas::coupling::PorosityMethod;
 use crate::engine::gas::fluid_forces::{DragCoupling, DragVelocities};
 use crate::engine::gas::grid::side;
+use crate::engine::gas::heat::GasThermal;
 use crate::engine::gas::linsolve::PressureSolver;
 use crate::engine::gas::simple::{InflowLevels, InflowRamp, InletFace};
 use crate::engine::gas::{Boundary, Convection, GasConfig, Grid};
@@ -21,6 +23,10 @@ use crate::engine::models::drag::DragLaw;
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize, schemars::JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct GasSpec {
+    /// Keep the section but simulate no gas: the particles move in vacuum (no drag, no convection), to separate
+    /// conduction from convection (seed 000 Fig. 72). Default false.
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub vacuum: bool,
     pub density_kg_per_m3: f64,
     pub viscosity_pa_s: f64,
     /// Gas cells along x, y, z (z = 1 for a pseudo-2-D bed). Seed 000: cells about 3 particle diameters wide.
@@ -223,6 +229,10 @@ pub struct GasSetup {
     pub min_porosity: f64,
     pub dem_steps_per_gas_step: u64,
     pub pressure_probe_height_m: Option<f64>,
+    /// For each entry of `gas.jets`, one past its last face in `config.inlet_faces`.
+    pub jet_face_ends: Vec<usize>,
+    /// The gas's energy and convection, in a run with heat transfer (set by `scenario/heat.rs`).
+    pub heat: Option<(GasThermal, GasScalarSpec)>,
 }
 
 impl GasSetup {
@@ -239,6 +249,9 @@ impl GasSetup {
             radii_m,
         )?;
         coupling.drag_coupling = self.drag_coupling;
+        if let Some((thermal, spec)) = &self.heat {
+            coupling.attach_heat(*thermal, spec.clone())?;
+        }
         Ok(coupling)
     }
 }
@@ -446,6 +459,7 @@ pub fn build_gas(
         }
     }
     let mut inlet_faces = Vec::new();
+    let mut jet_face_ends = Vec::with_capacity(spec.jets.len());
     for (k, jet) in spec.jets.iter().enumerate() {
         let key = |f: &str| format!("gas.jets[{k}].{f}");
         let Some(index) = SIDE_NAMES.iter().position(|n| *n == jet.side) else {
@@ -500,6 +514,7 @@ pub fn build_gas(
                 "the box holds no face centre of that side; widen it to at least one gas cell".into(),
             ));
         }
+        jet_face_ends.push(inlet_faces.len());
     }
     if let Some(h) = spec.pressure_probe_height_m {
         positive("pressure_probe_height_m", h)?;
@@ -566,5 +581,7 @@ pub fn build_gas(
         min_porosity: spec.min_porosity,
         dem_steps_per_gas_step: spec.dem_steps_per_gas_step,
         pressure_probe_height_m: spec.pressure_probe_height_m,
+        jet_face_ends,
+        heat: None,
     })
 }

@@ -6,6 +6,7 @@
 
 mod build;
 pub mod gas;
+mod heat;
 mod locate;
 pub mod spec;
 

@@ -49,21 +49,35 @@ pub struct ScenarioSpec {
     /// no particle–sidewall or no particle–distributor cohesion); absent: none.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub cohesion_off: Option<CohesionOff>,
+    /// Heat transfer: particle temperatures and conduction; absent: none.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub heat: Option<HeatSpec>,
 }
 
 /// A particle material as the scenario writes it (`build.rs` turns it into the engine's `Species`). Walls are
-/// species too.
+/// species too. A named `material` (seed 000's Table 7) supplies every property the entry leaves out; a property
+/// given explicitly wins, and a Young's modulus given beside a material is the simulation's (softened) one, the
+/// material's being the real one (`real_youngs_modulus_pa`).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize, schemars::JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct SpeciesSpec {
     pub name: String,
+    /// A named material whose properties fill in those not given here.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub material: Option<Material>,
     /// Nominal radius of particles created from this species (walls ignore it).
     pub radius_m: f64,
-    pub density_kg_per_m3: f64,
-    pub youngs_modulus_pa: f64,
-    pub poisson_ratio: f64,
+    /// Required unless `material` gives it (as are the Young's modulus, Poisson ratio and friction coefficient).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub density_kg_per_m3: Option<f64>,
+    /// The modulus the contact law uses (may be softened to allow a longer time step).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub youngs_modulus_pa: Option<f64>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub poisson_ratio: Option<f64>,
     /// Coulomb sliding friction coefficient μ.
-    pub friction_coefficient: f64,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub friction_coefficient: Option<f64>,
     /// Thornton yield force F_y (seed 000 eq. 2.7; "essentially a fitting parameter"). Only the Thornton normal
     /// model reads it; `None` means the material never yields.
     #[serde(default)]
@@ -71,9 +85,15 @@ pub struct SpeciesSpec {
     /// Rolling-resistance coefficient μ_r for the optional rolling slot (dimensionless).
     #[serde(default)]
     pub rolling_friction_coefficient: f64,
-    /// Reserved for heat transfer: solid conductivity and heat capacity.
+    /// The material's real Young's modulus where `youngs_modulus_pa` is softened: heat conduction scales the
+    /// contact radius back to the real material's (`heat.soft_contact_correction`). Default: the `material`'s when
+    /// it differs from `youngs_modulus_pa`, else none.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub real_youngs_modulus_pa: Option<f64>,
+    /// Solid thermal conductivity k_s, W/(m K) (heat transfer; default: the `material`'s).
     #[serde(default)]
     pub thermal_conductivity_w_per_m_k: Option<f64>,
+    /// Specific heat capacity c_p, J/(kg K) (heat transfer; default: the `material`'s).
     #[serde(default)]
     pub heat_capacity_j_per_kg_k: Option<f64>,
     /// Contact angle θ of the cohesion model's liquid on this material, degrees (liquid bridges; default 0).
@@ -83,6 +103,139 @@ pub struct SpeciesSpec {
     /// up to 0.02; default 0: dry).
     #[serde(default)]
     pub liquid_content: f64,
+}
+
+/// The named materials of seed 000's Table 7 (the rotary kiln, §5.2).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, schemars::JsonSchema)]
+#[serde(rename_all = "snake_case")]
+pub enum Material {
+    /// ρ 2700 kg/m³ (the seed's value), E 69 GPa, ν 0.33, μ 0.3, k 1.7 W/(m K), c 800 J/(kg K).
+    Glass,
+    /// ρ 7900 kg/m³, E 193 GPa, ν 0.29, μ 0.3, k 15 W/(m K), c 477 J/(kg K).
+    Steel,
+    /// ρ 2700 kg/m³, E 110 GPa, ν 0.33, μ 0.3, k 180 W/(m K), c 900 J/(kg K). Also spelt `aluminum`.
+    #[serde(alias = "aluminum")]
+    Aluminium,
+}
+
+/// The properties of a named [`Material`], SI.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct MaterialProperties {
+    pub density_kg_per_m3: f64,
+    pub youngs_modulus_pa: f64,
+    pub poisson_ratio: f64,
+    pub friction_coefficient: f64,
+    pub thermal_conductivity_w_per_m_k: f64,
+    pub heat_capacity_j_per_kg_k: f64,
+}
+
+impl Material {
+    /// Seed 000, Table 7.
+    pub fn properties(self) -> MaterialProperties {
+        let (
+            density_kg_per_m3,
+            youngs_modulus_pa,
+            poisson_ratio,
+            thermal_conductivity_w_per_m_k,
+            heat_capacity_j_per_kg_k,
+        ) = match self {
+            Material::Glass => (2700.0, 69.0e9, 0.33, 1.7, 800.0),
+            Material::Steel => (7900.0, 193.0e9, 0.29, 15.0, 477.0),
+            Material::Aluminium => (2700.0, 110.0e9, 0.33, 180.0, 900.0),
+        };
+        MaterialProperties {
+            density_kg_per_m3,
+            youngs_modulus_pa,
+            poisson_ratio,
+            friction_coefficient: 0.3,
+            thermal_conductivity_w_per_m_k,
+            heat_capacity_j_per_kg_k,
+        }
+    }
+}
+
+/// Heat transfer (seed 000 chapter 5): particle temperatures, conduction through contacts, walls and liquid
+/// bridges. Absent: no temperatures.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, schemars::JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct HeatSpec {
+    /// Temperature of the particles whose fill states none, K.
+    pub initial_temperature_k: f64,
+    /// Walls by name (`box_x_lo` … for a box) with a fixed temperature or adiabatic; a wall not listed is
+    /// adiabatic.
+    #[serde(default)]
+    pub walls: std::collections::BTreeMap<String, WallHeatSpec>,
+    /// Scale the contact radius of a softened species back to its real modulus's for conduction (where a species
+    /// states or its material gives a real modulus). Default true.
+    #[serde(default = "yes", skip_serializing_if = "is_true")]
+    pub soft_contact_correction: bool,
+    /// The gas's thermal properties and convection, used when the scenario has a `gas` (not in `vacuum`).
+    #[serde(default)]
+    pub gas: GasHeatSpec,
+}
+
+/// The gas's energy (seed 000 eq. 5.8) and its convection with the particles (eqs. 5.5–5.7). Defaults: Table 7's
+/// air and seed 000's correlation.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, schemars::JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct GasHeatSpec {
+    /// k_g, W/(m K) (default 0.0261, air).
+    #[serde(default = "air_conductivity")]
+    pub conductivity_w_per_m_k: f64,
+    /// c_g, J/(kg K) (default 1000.7, air).
+    #[serde(default = "air_heat_capacity")]
+    pub heat_capacity_j_per_kg_k: f64,
+    /// The Nusselt correlation of h_gp (default `seed000` with coefficient 1.8).
+    #[serde(default)]
+    pub nusselt: crate::engine::models::convection::NusseltCorrelation,
+    /// The gas's temperature at the start, K (default `heat.initial_temperature_k`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub initial_temperature_k: Option<f64>,
+    /// Temperature of the gas entering through inlet sides and jets, K (default the gas's initial temperature).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub inlet_temperature_k: Option<f64>,
+    /// Each jet's own inlet temperature, K, in the order of `gas.jets` (default: `inlet_temperature_k`).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub jet_temperatures_k: Vec<f64>,
+}
+
+fn air_conductivity() -> f64 {
+    0.0261
+}
+
+fn air_heat_capacity() -> f64 {
+    1000.7
+}
+
+impl Default for GasHeatSpec {
+    fn default() -> Self {
+        GasHeatSpec {
+            conductivity_w_per_m_k: air_conductivity(),
+            heat_capacity_j_per_kg_k: air_heat_capacity(),
+            nusselt: Default::default(),
+            initial_temperature_k: None,
+            inlet_temperature_k: None,
+            jet_temperatures_k: Vec::new(),
+        }
+    }
+}
+
+/// A wall's thermal condition: `temperature_k` (fixed) or `adiabatic: true`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, schemars::JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct WallHeatSpec {
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub temperature_k: Option<f64>,
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub adiabatic: bool,
+}
+
+fn yes() -> bool {
+    true
+}
+
+fn is_true(b: &bool) -> bool {
+    *b
 }
 
 /// Gravity as the scenario writes it.
@@ -221,6 +374,9 @@ pub enum FillSpec {
         /// At most half the gap between neighbours: 2·jitter_m ≤ spacing_m − particle diameter.
         #[serde(default)]
         jitter_m: f64,
+        /// Initial temperature of these particles, K (a run with `heat`; default `heat.initial_temperature_k`).
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        temperature_k: Option<f64>,
     },
     /// Particles at given positions, optionally with initial velocities and angular velocities.
     Explicit {
@@ -230,6 +386,9 @@ pub enum FillSpec {
         velocities_m_per_s: Vec<[f64; 3]>,
         #[serde(default)]
         angular_velocities_rad_per_s: Vec<[f64; 3]>,
+        /// Initial temperature of these particles, K (a run with `heat`; default `heat.initial_temperature_k`).
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        temperature_k: Option<f64>,
     },
     /// `count` non-overlapping particles at random positions in [lo_m, hi_m] (random sequential insertion with the
     /// scenario seed), optionally only inside a drum.
@@ -240,7 +399,30 @@ pub enum FillSpec {
         hi_m: [f64; 3],
         #[serde(default)]
         inside_drum: Option<String>,
+        /// Initial temperature of these particles, K (a run with `heat`; default `heat.initial_temperature_k`).
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        temperature_k: Option<f64>,
     },
+}
+
+impl FillSpec {
+    /// The fill's own initial temperature, K, if it states one.
+    pub fn temperature_k(&self) -> Option<f64> {
+        match self {
+            FillSpec::Lattice { temperature_k, .. }
+            | FillSpec::Explicit { temperature_k, .. }
+            | FillSpec::Random { temperature_k, .. } => *temperature_k,
+        }
+    }
+
+    /// Its key in the scenario's `fill` list entry (`lattice`, `explicit`, `random`).
+    pub fn kind(&self) -> &'static str {
+        match self {
+            FillSpec::Lattice { .. } => "lattice",
+            FillSpec::Explicit { .. } => "explicit",
+            FillSpec::Random { .. } => "random",
+        }
+    }
 }
 
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize, schemars::JsonSchema)]

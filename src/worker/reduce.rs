@@ -293,10 +293,10 @@ fn wet_number(metric: JobMetric, job: &JobSpec, built: &BuiltScenario, sim: &Sim
     let g = built.spec.gravity.vector_m_per_s2;
     let g = (g[0] * g[0] + g[1] * g[1] + g[2] * g[2]).sqrt();
     let kind = |k: usize| {
-        built.spec.species.get(k).map(|s| WetParticle {
+        built.config.species.species.get(k).map(|s| WetParticle {
             radius_m: s.radius_m,
             density_kg_per_m3: s.density_kg_per_m3,
-            contact_angle_rad: s.contact_angle_deg.to_radians(),
+            contact_angle_rad: s.contact_angle_rad,
         })
     };
     let (Some(a), b) = (kind(0), kind(1)) else {

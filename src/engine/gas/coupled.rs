@@ -84,6 +84,12 @@ impl GasSnapshot {
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct GasScalarId(usize);
 
+impl GasScalarId {
+    pub(crate) fn index(self) -> usize {
+        self.0
+    }
+}
+
 pub struct GasCoupling {
     pub solver: GasSolver,
     pub fluid: FluidForces,
@@ -99,7 +105,9 @@ pub struct GasCoupling {
     /// Wall time spent in the gas's linear solvers (not checkpointed; for profiles), s.
     pub linear_solve_s: f64,
     /// The transported scalars, in declaration order.
-    scalars: Vec<TransportedScalar>,
+    pub(crate) scalars: Vec<TransportedScalar>,
+    /// The gas's energy and its convection with the particles (`heat.rs`); `None`: no temperature.
+    pub heat: Option<super::heat::GasHeat>,
 }
 
 impl GasCoupling {
@@ -144,6 +152,7 @@ impl GasCoupling {
             last: GasStepStats::default(),
             linear_solve_s: 0.0,
             scalars: Vec::new(),
+            heat: None,
         })
     }
 

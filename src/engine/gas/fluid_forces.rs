@@ -175,7 +175,7 @@ impl FluidForces {
     }
 
     /// The cell holding `x` (clamped into a non-periodic grid, wrapped on a periodic axis), as a flat index.
-    fn cell_of(&self, x: &Vec3) -> usize {
+    pub(crate) fn cell_of(&self, x: &Vec3) -> usize {
         let grid = &self.grid;
         grid.cell(std::array::from_fn(|a| {
             let c = ((x[a] - grid.origin_m[a]) * self.inverse_h_per_m[a]).floor() as isize;
@@ -191,7 +191,7 @@ impl FluidForces {
     }
 
     /// The cell's index triple from its flat index.
-    fn cell_indices(&self, c: usize) -> [usize; 3] {
+    pub(crate) fn cell_indices(&self, c: usize) -> [usize; 3] {
         let n = self.grid.n;
         [c % n[0], (c / n[0]) % n[1], c / (n[0] * n[1])]
     }
@@ -209,7 +209,7 @@ impl FluidForces {
     }
 
     /// The gas velocity at the centre of cell `c`: the mean of its two faces along each axis.
-    fn cell_gas_velocity(&self, c: [usize; 3]) -> Vec3 {
+    pub(crate) fn cell_gas_velocity(&self, c: [usize; 3]) -> Vec3 {
         let grid = &self.grid;
         let mut u = Vec3::zeros();
         for a in 0..grid.axes() {

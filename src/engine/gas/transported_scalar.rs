@@ -7,15 +7,29 @@
 //! - a wall passes no flux, or holds the scalar at a value when the spec says so;
 //! - blocked cells are outside the gas: nothing crosses their faces, they keep their value (CHOICE: adiabatic;
 //!   conduction through a kiln wall is a model of its own);
-//! - the particles exchange K (φ_p − φ) per unit volume, implicitly, from the means of the accumulator.
+//! - the particles exchange K (φ_p − φ) per unit volume, implicitly from the means of the accumulator's coefficients
+//!   ([`ScalarExchange::Implicit`]), or explicitly as the mean of what the particles actually gave under the frozen
+//!   field ([`ScalarExchange::Explicit`]: the gas receives exactly what the particles lost, so the two together
+//!   conserve the scalar to rounding).
 //!
-//! What fills the accumulator (a heat-transfer law, evaporation) is not here.
+//! What fills the accumulator (gas–particle convection, evaporation) is the coupling's (`super::heat`).
 
 use super::exchange_accumulator::ExchangeAccumulator;
 use super::grid::{Boundary, side};
 use super::linsolve::SolveReport;
 use super::scalar::ScalarEquation;
 use super::simple::{GasSolver, face_index};
+
+/// How the gas takes the particles' exchange.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum ScalarExchange {
+    /// Σk (φ_p − φ) with φ at the end of the gas step (unconditionally stable; the gas's and the particles' shares
+    /// differ by how much φ moved over the step).
+    Implicit,
+    /// The mean transfer the particles computed under the frozen field, as an explicit source (exactly the
+    /// opposite of what the particles received; stable while the gas step is short against ε ρ / Σk).
+    Explicit,
+}
 
 /// A scalar's condition on a wall side.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -44,6 +58,7 @@ pub struct GasScalarSpec {
     pub jet_values: Vec<f64>,
     /// The condition on each side (`grid::side` order) that is a wall; must be `ZeroFlux` on the other sides.
     pub walls: [ScalarWall; 6],
+    pub exchange: ScalarExchange,
 }
 
 impl GasScalarSpec {
@@ -159,8 +174,14 @@ impl TransportedScalar {
     ) -> Result<SolveReport, String> {
         let config = &solver.config;
         let boundary_value = self.boundary_values(solver);
-        let (coefficient, coefficient_value) =
-            (self.exchange.mean_coefficient(), self.exchange.mean_coefficient_value());
+        let (coefficient, coefficient_value, source) = match self.spec.exchange {
+            ScalarExchange::Implicit => (
+                self.exchange.mean_coefficient(),
+                self.exchange.mean_coefficient_value(),
+                Vec::new(),
+            ),
+            ScalarExchange::Explicit => (Vec::new(), Vec::new(), self.exchange.mean_transfer()),
+        };
         let equation = ScalarEquation {
             grid: &config.grid,
             convection: config.convection,
@@ -171,7 +192,7 @@ impl TransportedScalar {
             old_porosity,
             boundary_value: &boundary_value,
             blocked: &config.blocked,
-            source: &[],
+            source: &source,
             exchange_coefficient: &coefficient,
             exchange_coefficient_value: &coefficient_value,
         };

@@ -1,0 +1,106 @@
+//! Heat transfer's run configuration (seed 000 chapter 5): what the pair pass needs to carry heat through every
+//! contact, and what the particles' temperature update needs.
+//!
+//! Each particle is lumped (one temperature; valid for Biot ≪ 1, §5.1.3) and its energy follows
+//! m c_p dT/dt = Σ Q_c (eq. 5.2): the pair pass sums the conduction through its contacts and walls into the
+//! `heat_flow_w` channel (`channels.rs`) in its fixed order, and as soon as a particle's sum is complete the pass
+//! advances its temperature by one explicit step, T += dt Q/(m c_p). Every pair's heat leaves one particle as it
+//! enters the other, so the particles' total energy Σ m c_p T changes only by what the walls give, to rounding.
+//! Temperatures are read at the start of the step (a particle's own is written only once all its contacts are
+//! done), so any thread count gives the same bits.
+
+use super::models::PairTable;
+use super::models::conduction::{ThermalPair, effective_modulus_pa};
+use super::particles::{Particles, SpeciesId, SpeciesTable};
+
+/// Everything heat transfer needs that does not change during a run.
+#[derive(Debug, Clone, PartialEq)]
+pub struct HeatConfig {
+    n_species: usize,
+    /// The conduction constants per species pair (walls are species), `n × n`.
+    pairs: Vec<ThermalPair>,
+    /// Per species, J/(kg K) (NaN where a species, e.g. a wall's, states none).
+    pub heat_capacity_j_per_kg_k: Vec<f64>,
+    /// Per wall: its fixed temperature, K, or `None` (adiabatic: no heat crosses it).
+    pub wall_temperature_k: Vec<Option<f64>>,
+}
+
+impl HeatConfig {
+    /// The conduction table of `species` under the contact law's moduli (`pair_table`), with the soft-contact
+    /// correction where `correct_soft_contacts` and a species states its real modulus, and the walls' conditions.
+    pub fn new(
+        species: &SpeciesTable,
+        pair_table: &PairTable,
+        correct_soft_contacts: bool,
+        wall_temperature_k: Vec<Option<f64>>,
+    ) -> HeatConfig {
+        let n = species.len();
+        let mut pairs = Vec::with_capacity(n * n);
+        for (a, sa) in species.species.iter().enumerate() {
+            for (b, sb) in species.species.iter().enumerate() {
+                let simulated = pair_table
+                    .get(SpeciesId(a as u16), SpeciesId(b as u16))
+                    .effective_youngs_modulus_pa;
+                let softened = sa.real_youngs_modulus_pa.is_some() || sb.real_youngs_modulus_pa.is_some();
+                let real = (correct_soft_contacts && softened).then(|| {
+                    effective_modulus_pa(
+                        sa.real_youngs_modulus_pa.unwrap_or(sa.youngs_modulus_pa),
+                        sa.poisson_ratio,
+                        sb.real_youngs_modulus_pa.unwrap_or(sb.youngs_modulus_pa),
+                        sb.poisson_ratio,
+                    )
+                });
+                pairs.push(ThermalPair::new(
+                    sa.thermal_conductivity_w_per_m_k,
+                    sb.thermal_conductivity_w_per_m_k,
+                    simulated,
+                    real,
+                ));
+            }
+        }
+        HeatConfig {
+            n_species: n,
+            pairs,
+            heat_capacity_j_per_kg_k: species
+                .species
+                .iter()
+                .map(|s| s.heat_capacity_j_per_kg_k.unwrap_or(f64::NAN))
+                .collect(),
+            wall_temperature_k,
+        }
+    }
+
+    /// The conduction constants of species pair (a, b).
+    #[inline(always)]
+    pub fn pair(&self, a: SpeciesId, b: SpeciesId) -> &ThermalPair {
+        &self.pairs[a.index() * self.n_species + b.index()]
+    }
+
+    /// 1/(m c_p) per particle, 1/(J/K).
+    pub fn inverse_thermal_mass(&self, p: &Particles) -> Vec<f64> {
+        p.mass_kg
+            .iter()
+            .zip(&p.species)
+            .map(|(m, s)| 1.0 / (m * self.heat_capacity_j_per_kg_k[s.index()]))
+            .collect()
+    }
+
+    /// The largest rate λ = Σ H (1/C_i + 1/C_j) any particle's temperature can relax at, 1/s, bounded from above
+    /// for the explicit step's stability (dt λ < 2): twelve partners and a wall, each at the largest overlap the run
+    /// tolerates (`max_overlap_fraction` of the radius), against the smallest thermal mass. A scenario whose time
+    /// step breaks it is refused.
+    pub fn fastest_relaxation_per_s(&self, p: &Particles, max_overlap_fraction: f64) -> f64 {
+        let inverse = self.inverse_thermal_mass(p);
+        let largest_inverse = inverse.iter().copied().fold(0.0, f64::max);
+        let largest_radius = p.max_radius_m();
+        let largest_pair = self
+            .pairs
+            .iter()
+            .map(|t| t.conductance_per_radius_w_per_m_k * t.radius_scale.max(1.0))
+            .fold(0.0, f64::max);
+        // The geometric radius √(R δ) at the tolerated overlap bounds every law's (the linear spring's corrected
+        // radius is the real, stiffer material's and smaller).
+        let contact_radius = (largest_radius * max_overlap_fraction * largest_radius).sqrt();
+        13.0 * largest_pair * contact_radius * 2.0 * largest_inverse
+    }
+}
