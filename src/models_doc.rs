@@ -89,7 +89,7 @@ fill (list of):
   explicit: { species, positions_m, velocities_m_per_s?, angular_velocities_rad_per_s?, temperature_k? }
 time: { end_time_s, dt_s | dt_fraction_of_contact_time, reference_velocity_m_per_s? }
 heat (optional: particle temperatures and conduction, seed 000 chapter 5):
-     { initial_temperature_k, walls?: { <wall name>: { temperature_k } | { adiabatic: true } },
+     { initial_temperature_k, walls?: { <wall name>: { temperature_k, from_s? } | { adiabatic: true } },
        soft_contact_correction? }                                        Q = 2 R_c k_s ΔT (eqs. 5.3-5.4), R_c the
                                                                          Hertz radius, k_s the harmonic mean; walls
                                                                          not listed are adiabatic; the correction
@@ -103,6 +103,7 @@ heat (optional: particle temperatures and conduction, seed 000 chapter 5):
              gunn                                                        Gunn (1978), beds
 gas (optional: a gas coupled to the particles, fluidized beds):
      { vacuum?, density_kg_per_m3, viscosity_pa_s, cells: [nx, ny, nz], dem_steps_per_gas_step, sides?, jets?, blocked?,
+       outside_drum?,
        drag?, drag_velocities?, drag_coupling?, porosity?, min_porosity?, convection?, solver?, inflow_ramp?,
        inflow_levels?, pressure_probe_height_m? }
   sides: { x_low?, x_high?, y_low?, y_high?, z_low?, z_high? }, each one of:
@@ -112,6 +113,8 @@ gas (optional: a gas coupled to the particles, fluidized beds):
     inlet: { superficial_velocity_m_per_s }                              uniform inflow (a distributor)
   jets (list of): { side, lo_m, hi_m, superficial_velocity_m_per_s }     faces of a side in a box (seed 002's jet)
   blocked (list of): { lo_m, hi_m }                                      cells outside the gas
+  outside_drum: <drum name>                                              a kiln: cells outside the drum are
+                                                                         blocked, their walls turn with it
   drag (default di_felice):
     di_felice                                                            seed 000 eqs. 2.71-2.73
     ergun_wen_yu                                                         seed 000 eq. 2.69 (eps^-2.65, C_d 0.44)

@@ -58,6 +58,8 @@ time: {{ dt_s: 1.0e-4, end_time_s: 2.0 }}
         inflow_ramp: None,
         inflow_levels: None,
         blocked: Vec::new(),
+        blocked_wall_motion: None,
+        pressure_reference_cell: None,
     };
     let mass = dem.particles.mass_kg[0];
     let mut dem = dem;

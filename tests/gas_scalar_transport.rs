@@ -40,6 +40,8 @@ fn config(grid: Grid, convection: Convection) -> GasConfig {
         inflow_ramp: None,
         inflow_levels: None,
         blocked: Vec::new(),
+        blocked_wall_motion: None,
+        pressure_reference_cell: None,
     }
 }
 
@@ -67,6 +69,8 @@ fn spec(name: &'static str, diffusion_kg_per_m_s: f64, initial_value: f64, inlet
         jet_values: Vec::new(),
         walls: [ScalarWall::ZeroFlux; 6],
         exchange: ScalarExchange::Implicit,
+        blocked_value: None,
+        fixed_from_s: 0.0,
     }
 }
 

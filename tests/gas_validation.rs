@@ -22,6 +22,8 @@ fn config(grid: Grid, density: f64, viscosity: f64, convection: Convection) -> G
         inflow_ramp: None,
         inflow_levels: None,
         blocked: Vec::new(),
+        blocked_wall_motion: None,
+        pressure_reference_cell: None,
     }
 }
 

@@ -23,6 +23,8 @@ pub struct HeatConfig {
     pub heat_capacity_j_per_kg_k: Vec<f64>,
     /// Per wall: its fixed temperature, K, or `None` (adiabatic: no heat crosses it).
     pub wall_temperature_k: Vec<Option<f64>>,
+    /// Per wall: the time from which a heated wall is at its temperature, s (adiabatic before).
+    pub wall_heated_from_s: Vec<f64>,
 }
 
 impl HeatConfig {
@@ -33,6 +35,7 @@ impl HeatConfig {
         pair_table: &PairTable,
         correct_soft_contacts: bool,
         wall_temperature_k: Vec<Option<f64>>,
+        wall_heated_from_s: Vec<f64>,
     ) -> HeatConfig {
         let n = species.len();
         let mut pairs = Vec::with_capacity(n * n);
@@ -67,7 +70,19 @@ impl HeatConfig {
                 .map(|s| s.heat_capacity_j_per_kg_k.unwrap_or(f64::NAN))
                 .collect(),
             wall_temperature_k,
+            wall_heated_from_s,
         }
+    }
+
+    /// Each wall's temperature at time `time_s` (`None`: adiabatic then), into `out`.
+    pub fn wall_temperatures_at(&self, time_s: f64, out: &mut Vec<Option<f64>>) {
+        out.clear();
+        out.extend(
+            self.wall_temperature_k
+                .iter()
+                .zip(&self.wall_heated_from_s)
+                .map(|(t, &from)| t.filter(|_| time_s >= from)),
+        );
     }
 
     /// The conduction constants of species pair (a, b).

@@ -291,6 +291,8 @@ struct Context<'a> {
     heat: Option<&'a HeatConfig>,
     /// 1/(m c_p) per particle (heat transfer only).
     inv_thermal_mass_per_j_k: &'a [f64],
+    /// Each wall's temperature this step, `None` while adiabatic (heat transfer only).
+    wall_temperature_k: &'a [Option<f64>],
 }
 
 /// Result of one wall slot: the contact's (force, torque) on i while it overlaps, the cohesion model's while it acts,
@@ -333,6 +335,7 @@ impl<'a> Context<'a> {
         cohesion: Option<&'a Cohesion>,
         bridges: &'a BridgeCache,
         channels: ChannelGroups,
+        wall_temperature_k: &'a [Option<f64>],
     ) -> Self {
         Context {
             config,
@@ -354,6 +357,7 @@ impl<'a> Context<'a> {
             statistics: channels.statistics,
             heat: config.heat.as_ref().filter(|_| channels.heat),
             inv_thermal_mass_per_j_k: &inverse.inv_thermal_mass_per_j_k,
+            wall_temperature_k,
         }
     }
 
@@ -600,7 +604,7 @@ impl<'a> Context<'a> {
                 *t += -(n.cross(&out.tangential_force) * ri) + out.rolling_torque;
                 if P::HEAT
                     && let Some(heat) = self.heat
-                    && let Some(wall_temperature_k) = heat.wall_temperature_k[w as usize]
+                    && let Some(wall_temperature_k) = self.wall_temperature_k[w as usize]
                 {
                     // As in `wall_slot`.
                     let conductance =
@@ -699,7 +703,7 @@ impl<'a> Context<'a> {
             self.contact_lasts::<P>(hist, k);
             if P::HEAT
                 && let Some(heat) = self.heat
-                && let Some(wall_temperature_k) = heat.wall_temperature_k[w as usize]
+                && let Some(wall_temperature_k) = self.wall_temperature_k[w as usize]
             {
                 // The wall an infinite particle at its own temperature (seed 000 §5.1.2.1); adiabatic walls pass
                 // nothing.
@@ -926,7 +930,9 @@ pub struct ForcePass {
 /// Computes the forces and torques of every pair and wall slot into `p.force_n` and `p.torque_n_m` (adding onto
 /// what they hold, e.g. the gas's forces) and, with `kick`, applies the second half kick to every particle.
 /// `cohesion`: the cohesion model when it acts this step, with `bridges` the constants of the standing bridges.
-/// Where the run records channels (`p.channels` not empty) the pass adds into them and times the contacts.
+/// Where the run records channels (`p.channels` not empty) the pass adds into them and times the contacts; with heat
+/// transfer it conducts heat through every contact and into the walls at `wall_temperature_k` (this step's), and
+/// advances each particle's temperature.
 ///
 /// The force and torque arrays are the accumulators of the pass. When the kick fuses the next step's drift, the
 /// totals are consumed at once and the arrays are left zero instead, so that the next pass (told so by
@@ -948,6 +954,7 @@ pub fn compute_pair_forces(
     accumulators_zeroed: bool,
     cohesion: Option<&Cohesion>,
     bridges: &BridgeCache,
+    wall_temperature_k: &[Option<f64>],
 ) -> ForcePass {
     let mut force = std::mem::take(&mut p.force_n);
     let mut torque = std::mem::take(&mut p.torque_n_m);
@@ -974,6 +981,7 @@ pub fn compute_pair_forces(
         cohesion,
         bridges,
         channels.groups(),
+        wall_temperature_k,
     );
     // One instantiation per pass kind: the layout decides which history fields exist, and knowing it at compile
     // time lets the kernels' unused fields vanish from the loop; a dry run has no cohesion code in it.
@@ -1072,6 +1080,7 @@ pub fn add_wall_forces(
         cohesion,
         bridges,
         ChannelGroups::NONE,
+        &[],
     );
     let motion = Plain {
         x: &p.position_m,

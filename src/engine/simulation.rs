@@ -70,6 +70,8 @@ struct Workspace {
     accumulators_zeroed: bool,
     /// Force passes since the particle ranges were last rebalanced.
     steps_since_rebalance: u64,
+    /// Each wall's temperature at the current step (heat transfer; `None` while adiabatic).
+    wall_temperature_k: Vec<Option<f64>>,
     /// Threads of the per-step parallel force pass, which also run the drift of an unfused step and the neighbour
     /// lists' work (shared with that work through the `Arc`).
     team: Arc<Team>,
@@ -128,6 +130,7 @@ impl Workspace {
             pending_drift: None,
             accumulators_zeroed: false,
             steps_since_rebalance: 0,
+            wall_temperature_k: Vec::new(),
             team: Arc::new(Team::new(threads)),
         }
     }
@@ -518,6 +521,9 @@ impl Simulation {
     /// The pair pass's forces at the current positions (contacts, and cohesion in a cohesive run); with `kick`, also
     /// the second half kick.
     fn forces(&mut self, dt: f64, kick: Option<HalfKick>) -> ForcePass {
+        if let Some(heat) = &self.config.heat {
+            heat.wall_temperatures_at(self.time_s, &mut self.work.wall_temperature_k);
+        }
         let pass = compute_pair_forces(
             &self.config,
             &mut self.particles,
@@ -533,6 +539,7 @@ impl Simulation {
             self.work.accumulators_zeroed,
             self.config.cohesion.as_ref(),
             &self.work.bridges,
+            &self.work.wall_temperature_k,
         );
         self.work.accumulators_zeroed = kick.is_some_and(|k| k.fuse_next_drift);
         self.cohesion_events.well_crossings += pass.well_crossings;

@@ -260,6 +260,9 @@ pub fn build(spec: ScenarioSpec, path: &Path) -> Result<BuiltScenario, ConfigErr
         // Checked as written, then switched off: the particles move in vacuum.
         gas = None;
     }
+    if let (Some(g), Some(name)) = (gas.as_mut(), spec.gas.as_ref().and_then(|g| g.outside_drum.as_ref())) {
+        block_outside_drum(&c, g, &walls, name)?;
+    }
     if let Some(g) = gas.as_mut() {
         super::heat::build_gas_heat(path, &spec, g)?;
     }
@@ -407,6 +410,63 @@ fn resolve_species(c: &Checker, k: usize, s: &SpeciesSpec) -> Result<Species, Co
         thermal_conductivity_w_per_m_k,
         heat_capacity_j_per_kg_k,
     })
+}
+
+/// Blocks the gas cells whose centres lie outside the drum `name` and makes their walls turn with it.
+fn block_outside_drum(
+    c: &Checker,
+    gas: &mut super::gas::GasSetup,
+    walls: &[Wall],
+    name: &str,
+) -> Result<(), ConfigError> {
+    let key = "gas.outside_drum";
+    let drum = drum_named(c, key, walls, name)?;
+    let WallShape::RotatingCylinder { frame, radius_m } = &drum.shape else {
+        return Err(c.fail(key, format!("wall '{name}' is not a drum")));
+    };
+    let grid = &gas.config.grid;
+    let mut blocked = if gas.config.blocked.is_empty() {
+        vec![false; grid.cells()]
+    } else {
+        gas.config.blocked.clone()
+    };
+    for k in 0..grid.n[2] {
+        for j in 0..grid.n[1] {
+            for i in 0..grid.n[0] {
+                let centre = Vec3::from(grid.cell_centre_m([i, j, k]));
+                let r = centre - frame.axis_point_m;
+                let off_axis = r - frame.axis * r.dot(&frame.axis);
+                if off_axis.norm() > *radius_m {
+                    blocked[grid.cell([i, j, k])] = true;
+                }
+            }
+        }
+    }
+    if blocked.iter().all(|&b| b) {
+        return Err(c.fail(key, format!("drum '{name}' holds no gas cell centre")));
+    }
+    // The reference pressure on top of the kiln (seed 000 §5.2): the open cell highest against gravity (the first in
+    // cell order among equals).
+    let up = -Vec3::from(gas.config.gravity_m_per_s2);
+    let height = |cell: usize| {
+        let n = grid.n;
+        let idx = [cell % n[0], (cell / n[0]) % n[1], cell / (n[0] * n[1])];
+        Vec3::from(grid.cell_centre_m(idx)).dot(&up)
+    };
+    let top = (0..grid.cells())
+        .filter(|&cell| !blocked[cell])
+        .fold(None, |best: Option<usize>, cell| match best {
+            Some(b) if height(b) >= height(cell) => Some(b),
+            _ => Some(cell),
+        });
+    gas.config.pressure_reference_cell = top;
+    gas.config.blocked = blocked;
+    gas.config.blocked_wall_motion = Some(crate::engine::gas::simple::BlockedWallMotion {
+        axis_point_m: frame.axis_point_m.into(),
+        axis: frame.axis.into(),
+        angular_velocity_rad_per_s: frame.angular_velocity_rad_per_s,
+    });
+    Ok(())
 }
 
 /// The engine's gravity from the scenario's.

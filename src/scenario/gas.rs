@@ -41,6 +41,11 @@ pub struct GasSpec {
     /// them). Particles need their own walls there.
     #[serde(default)]
     pub blocked: Vec<BoxSpec>,
+    /// A rotary kiln: the cells whose centres lie outside this drum (by name, a `drum` wall) are blocked too, and
+    /// their walls turn with the drum (no slip on the moving wall; seed 000 §5.1.1's kiln, with the circle as a
+    /// staircase of cell faces).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub outside_drum: Option<String>,
     #[serde(default = "default_drag")]
     pub drag: DragLaw,
     /// Which velocities drag is computed from: `instantaneous` (each particle's own, gas interpolated to it) or
@@ -569,6 +574,8 @@ pub fn build_gas(
         inflow_ramp: spec.inflow_ramp,
         inflow_levels: spec.inflow_levels.clone(),
         blocked,
+        blocked_wall_motion: None,
+        pressure_reference_cell: None,
     };
     config.grid.check().map_err(|m| fail("gas.cells".into(), m))?;
     crate::engine::gas::GasSolver::new(config.clone()).map_err(|m| fail("gas".into(), m))?;

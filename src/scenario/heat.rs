@@ -111,6 +111,7 @@ pub(super) fn build_heat(
         }
     }
     let mut wall_temperature_k = vec![None; walls.len()];
+    let mut wall_heated_from_s = vec![0.0; walls.len()];
     for (name, condition) in &heat.walls {
         let key = |field: &str| format!("heat.walls.{name}{field}");
         let Some(w) = walls.iter().position(|w| &w.name == name) else {
@@ -123,7 +124,14 @@ pub(super) fn build_heat(
         match (condition.temperature_k, condition.adiabatic) {
             (Some(t), false) => {
                 temperature(key(".temperature_k"), t)?;
+                if !(condition.from_s.is_finite() && condition.from_s >= 0.0) {
+                    return Err(fail(
+                        key(".from_s"),
+                        format!("expected a time >= 0 s, got {}", condition.from_s),
+                    ));
+                }
                 wall_temperature_k[w] = Some(t);
+                wall_heated_from_s[w] = condition.from_s;
             }
             (None, true) => {}
             (Some(_), true) => {
@@ -140,7 +148,13 @@ pub(super) fn build_heat(
             }
         }
     }
-    let config = HeatConfig::new(species, pair_table, heat.soft_contact_correction, wall_temperature_k);
+    let config = HeatConfig::new(
+        species,
+        pair_table,
+        heat.soft_contact_correction,
+        wall_temperature_k,
+        wall_heated_from_s,
+    );
     let rate_per_s = config.fastest_relaxation_per_s(particles, spec.max_overlap_fraction);
     if dt_s * rate_per_s >= 1.0 {
         return Err(fail(
@@ -196,6 +210,17 @@ pub(super) fn build_gas_heat(path: &Path, spec: &ScenarioSpec, gas: &mut GasSetu
             _ => ScalarWall::ZeroFlux,
         }
     });
+    // A kiln's drum (the gas's `outside_drum`) holds the faces of the blocked cells at its temperature. CHOICE: the
+    // gas's heated walls act from the earliest `from_s` among them.
+    let drum = spec.gas.as_ref().and_then(|g| g.outside_drum.as_ref());
+    let blocked_value = drum.and_then(|name| heat.walls.get(name)).and_then(|w| w.temperature_k);
+    let fixed_from_s = heat
+        .walls
+        .iter()
+        .filter(|(_, w)| w.temperature_k.is_some())
+        .map(|(_, w)| w.from_s)
+        .fold(f64::INFINITY, f64::min);
+    let fixed_from_s = if fixed_from_s.is_finite() { fixed_from_s } else { 0.0 };
     let thermal = GasThermal {
         conductivity_w_per_m_k: g.conductivity_w_per_m_k,
         heat_capacity_j_per_kg_k: g.heat_capacity_j_per_kg_k,
@@ -212,6 +237,8 @@ pub(super) fn build_gas_heat(path: &Path, spec: &ScenarioSpec, gas: &mut GasSetu
             jet_values,
             walls,
             exchange: ScalarExchange::Explicit,
+            blocked_value,
+            fixed_from_s,
         },
     ));
     Ok(())

@@ -228,6 +228,13 @@ pub struct WallHeatSpec {
     pub temperature_k: Option<f64>,
     #[serde(default, skip_serializing_if = "std::ops::Not::not")]
     pub adiabatic: bool,
+    /// A heated wall is adiabatic until this time, s (the bed settles first; default 0).
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub from_s: f64,
+}
+
+fn is_zero(x: &f64) -> bool {
+    *x == 0.0
 }
 
 fn yes() -> bool {

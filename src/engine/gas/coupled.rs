@@ -136,6 +136,7 @@ impl GasCoupling {
             solver.config.viscosity_pa_s,
         );
         fluid.drag_velocities = drag_velocities;
+        fluid.blocked.clone_from(&solver.config.blocked);
         fluid.freeze(
             &solver.interstitial_velocity_m_per_s(),
             &solver.state.pressure_pa,

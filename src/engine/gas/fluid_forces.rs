@@ -89,6 +89,9 @@ pub struct FluidForces {
     /// −∂p/∂x_a on the faces of component a, Pa/m.
     pub minus_pressure_gradient_pa_per_m: [Vec<f64>; 3],
     pub porosity: Vec<f64>,
+    /// Cells outside the gas (the solver's `blocked`), or empty: the faces between them and the gas carry no
+    /// pressure gradient (a blocked cell's pressure is not the gas's).
+    pub blocked: Vec<bool>,
     /// The momentum exchange since the freeze, one accumulator per velocity component over its faces: the
     /// transfer is the force on the gas per unit volume, N/m³ (the reaction to drag); the coefficient is w K /
     /// V_cell, N·s/m⁴ (the β the semi-implicit coupling puts into the gas momentum equation as −β u); the
@@ -127,6 +130,7 @@ impl FluidForces {
             minus_pressure_gradient_pa_per_m: zeros(&grid),
             momentum_exchange: std::array::from_fn(|a| ExchangeAccumulator::new(grid.faces(a))),
             porosity: vec![1.0; grid.cells()],
+            blocked: Vec::new(),
             lattice: std::array::from_fn(|a| FaceLattice::new(&grid, a)),
             inverse_h_per_m: std::array::from_fn(|a| 1.0 / grid.h_m[a]),
             periodic: std::array::from_fn(|a| grid.periodic(a)),
@@ -156,7 +160,9 @@ impl FluidForces {
                             c[a] = at;
                             pressure_pa[grid.cell(c)]
                         };
-                        let g = if grid.periodic(a) {
+                        let g = if super::simple::face_touches_blocked(grid, &self.blocked, a, idx) {
+                            0.0
+                        } else if grid.periodic(a) {
                             (cell((along + n - 1) % n) - cell(along % n)) / grid.h_m[a]
                         } else if n == 1 {
                             0.0

@@ -49,6 +49,8 @@ pub struct ScalarEquation<'a> {
     pub boundary_value: &'a [Vec<Option<f64>>; 3],
     /// Cells outside the gas, one flag per cell, or empty for none.
     pub blocked: &'a [bool],
+    /// φ held on the faces between gas and blocked cells (diffusion over the half cell), or `None`: no flux.
+    pub blocked_value: Option<f64>,
     /// Explicit source per unit volume at each cell, (unit of φ)·kg/(m³·s); empty for none.
     pub source: &'a [f64],
     /// The particle exchange coefficient K per unit volume at each cell, kg/(m³·s); empty for none.
@@ -119,6 +121,12 @@ impl ScalarEquation<'_> {
                                 Some(nb) => {
                                     let q = grid.cell(nb);
                                     if self.is_blocked(q) {
+                                        if let Some(value) = self.blocked_value {
+                                            let diffusion = gamma * eps[p] * area / (0.5 * grid.h_m[a]);
+                                            let a_b = self.neighbour_coefficient(0.0, diffusion);
+                                            ap += a_b;
+                                            b += a_b * value;
+                                        }
                                         continue;
                                     }
                                     let diffusion = gamma * 0.5 * (eps[p] + eps[q]) * area / grid.h_m[a];
@@ -248,6 +256,7 @@ pub fn step_scalar(problem: &ScalarProblem, phi: &mut [f64], dt_s: f64, toleranc
         old_porosity: eps,
         boundary_value: &boundary_value,
         blocked: &[],
+        blocked_value: None,
         source: problem.source,
         exchange_coefficient: &[],
         exchange_coefficient_value: &[],

@@ -17,7 +17,8 @@ use serde::{Deserialize, Serialize};
 
 use super::grid::{Boundary, Grid, side};
 use super::linsolve::{
-    NONE, PressureSolver, SolveReport, StencilSystem, bandwidth, bicgstab, conjugate_gradient, direct_symmetric,
+    NEIGHBOURS, NONE, PressureSolver, SolveReport, StencilSystem, bandwidth, bicgstab, conjugate_gradient,
+    direct_symmetric,
 };
 
 /// The convection scheme.
@@ -58,8 +59,37 @@ pub struct GasConfig {
     /// Inflow changed in steps (a defluidization/fluidization cycle): multiplies the ramp's factor.
     pub inflow_levels: Option<InflowLevels>,
     /// Cells outside the gas domain (solid: a kiln wall's outside), one flag per cell, or empty for none. Their
-    /// faces are no-slip walls at rest; the design leaves room for moving them (a wall velocity per face).
+    /// faces are no-slip walls, at rest or moving with `blocked_wall_motion`.
     pub blocked: Vec<bool>,
+    /// The blocked cells' walls turn about an axis (a rotary kiln's drum): the gas beside them takes the wall's
+    /// tangential velocity ω × (x − x_axis) at the wall, half a cell from the face's centre. `None`: at rest.
+    pub blocked_wall_motion: Option<BlockedWallMotion>,
+    /// A cell whose pressure is held at the reference 0 and whose mass balance is not enforced (seed 000's kiln:
+    /// "the reference pressure 0 is designated on top of the kiln"): in a domain closed by walls and blocked cells
+    /// it takes up the gas volume that moving particles displace. `None`: every open cell balances its mass.
+    pub pressure_reference_cell: Option<usize>,
+}
+
+/// The rotation of the blocked cells' walls.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct BlockedWallMotion {
+    pub axis_point_m: [f64; 3],
+    /// Unit axis (right-handed rotation).
+    pub axis: [f64; 3],
+    pub angular_velocity_rad_per_s: f64,
+}
+
+impl BlockedWallMotion {
+    /// The wall's velocity at `x`, m/s.
+    pub fn velocity_at(&self, x: [f64; 3]) -> [f64; 3] {
+        let (a, w) = (self.axis, self.angular_velocity_rad_per_s);
+        let r: [f64; 3] = std::array::from_fn(|k| x[k] - self.axis_point_m[k]);
+        [
+            w * (a[1] * r[2] - a[2] * r[1]),
+            w * (a[2] * r[0] - a[0] * r[2]),
+            w * (a[0] * r[1] - a[1] * r[0]),
+        ]
+    }
 }
 
 /// One boundary face with a prescribed normal velocity.
@@ -528,11 +558,14 @@ impl GasSolver {
                             net_out += sign * flux;
                         }
                         _ => {
-                            // A wall or inlet along d (or blocked cells: a wall at rest): the ghost value is the
-                            // side's tangential velocity, half a cell away.
+                            // A wall or inlet along d (or blocked cells: a wall at rest or turning with
+                            // `blocked_wall_motion`): the ghost value is the wall's tangential velocity, half a cell
+                            // away.
                             let boundary = if neighbour_lo.is_some() && neighbour_hi.is_some() {
+                                let mut wall = grid.face_centre_m(c, idx);
+                                wall[dax] += sign * 0.5 * grid.h_m[dax];
                                 Boundary::Wall {
-                                    velocity_m_per_s: [0.0; 3],
+                                    velocity_m_per_s: cfg.blocked_wall_motion.map_or([0.0; 3], |m| m.velocity_at(wall)),
                                 }
                             } else {
                                 grid.boundary[side(dax, high)]
@@ -606,15 +639,20 @@ impl GasSolver {
                     {
                         let coeff = rho * eps_f * area * self.d[a][solved_face];
                         sys.ap[pcell] += coeff;
-                        sys.nb[pcell][slot] = grid.cell(nb) as u32;
-                        sys.anb[pcell][slot] = coeff;
-                        slot += 1;
+                        // The reference cell's p' is 0: a Dirichlet neighbour, kept out of the (symmetric) stencil.
+                        if self.config.pressure_reference_cell != Some(grid.cell(nb)) {
+                            sys.nb[pcell][slot] = grid.cell(nb) as u32;
+                            sys.anb[pcell][slot] = coeff;
+                            slot += 1;
+                        }
                     }
                 }
             }
-            if cell_blocked(grid, &self.config.blocked, idx) {
-                // Outside the gas: p' = 0.
+            if cell_blocked(grid, &self.config.blocked, idx) || self.config.pressure_reference_cell == Some(pcell) {
+                // Outside the gas, or the reference cell: p' = 0.
                 sys.ap[pcell] = 1.0;
+                sys.nb[pcell] = [NONE; NEIGHBOURS];
+                sys.anb[pcell] = [0.0; NEIGHBOURS];
                 sys.b[pcell] = 0.0;
                 continue;
             }

@@ -59,6 +59,12 @@ pub struct GasScalarSpec {
     /// The condition on each side (`grid::side` order) that is a wall; must be `ZeroFlux` on the other sides.
     pub walls: [ScalarWall; 6],
     pub exchange: ScalarExchange,
+    /// The value the faces of blocked cells hold (a kiln's heated drum), diffusing into the gas beside them;
+    /// `None`: they pass nothing.
+    pub blocked_value: Option<f64>,
+    /// Walls held at a value (and `blocked_value`) act from this gas time on, s; before it they pass nothing (a
+    /// kiln's wall heats once its bed has settled).
+    pub fixed_from_s: f64,
 }
 
 impl GasScalarSpec {
@@ -147,7 +153,7 @@ impl TransportedScalar {
                 let s = side(a, along == grid.n[a]);
                 *value = match (grid.boundary[s], self.spec.walls[s]) {
                     (Boundary::Inlet { .. }, _) => Some(self.spec.inlet_value),
-                    (Boundary::Wall { .. }, ScalarWall::Fixed { value }) => Some(value),
+                    (Boundary::Wall { .. }, ScalarWall::Fixed { value }) if self.fixed_active(solver) => Some(value),
                     _ => None,
                 };
             }
@@ -160,6 +166,11 @@ impl TransportedScalar {
             }
         }
         values
+    }
+
+    /// Whether the walls held at a value act at the solver's current time.
+    fn fixed_active(&self, solver: &GasSolver) -> bool {
+        solver.state.time_s >= self.spec.fixed_from_s
     }
 
     /// Advances φ over the gas step of `dt_s` that `solver` has just taken from porosity `old_porosity`, with the
@@ -192,6 +203,7 @@ impl TransportedScalar {
             old_porosity,
             boundary_value: &boundary_value,
             blocked: &config.blocked,
+            blocked_value: self.spec.blocked_value.filter(|_| self.fixed_active(solver)),
             source: &source,
             exchange_coefficient: &coefficient,
             exchange_coefficient_value: &coefficient_value,
