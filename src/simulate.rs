@@ -59,6 +59,61 @@ pub struct Summary {
     pub build: String,
     /// The compilation of the force loop it ran ([`crate::provenance::cpu_path`]).
     pub cpu_path: String,
+    /// In a run with heat transfer, the lumped-particle check at the end ([`biot_numbers`]).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub biot_numbers: Option<BiotNumbers>,
+}
+
+/// Seed 000 §5.1.3's Biot numbers at the end of a run: a lumped particle temperature needs both ≪ 1.
+#[derive(Debug, Clone, Copy, serde::Serialize)]
+pub struct BiotNumbers {
+    /// The largest (2/π) √(δ/R) over touching pairs and wall contacts (eq. 5.15: contact conductance against the
+    /// particle's internal conduction; R the smaller radius, δ the overlap); 0 without contacts.
+    pub contact_max: f64,
+    /// The largest h_gp R / k_s over the particles (eq. 5.13); 0 without a gas.
+    pub convection_max: f64,
+}
+
+/// The [`BiotNumbers`] of the current state, `None` without heat transfer.
+pub fn biot_numbers(sim: &Simulation) -> Option<BiotNumbers> {
+    let p = &sim.particles;
+    if p.temperature_k.is_empty() {
+        return None;
+    }
+    let contacts = sim.snapshot().contacts;
+    let biot = |overlap: f64, radius: f64| 2.0 / std::f64::consts::PI * (overlap.max(0.0) / radius).sqrt();
+    let pairs = contacts.pairs.iter().filter(|(_, _, h)| h.active).map(|(i, j, _)| {
+        let (i, j) = (i.index(), j.index());
+        let separation = sim.config.domain.separation(&p.position_m[i], &p.position_m[j]).norm();
+        biot(
+            p.radius_m[i] + p.radius_m[j] - separation,
+            p.radius_m[i].min(p.radius_m[j]),
+        )
+    });
+    let walls = contacts.walls.iter().filter(|(_, _, h)| h.active).map(|(i, w, _)| {
+        let (i, w) = (i.index(), w.0 as usize);
+        let gap = sim.config.walls[w]
+            .proximity(&p.position_m[i], sim.wall_angle_rad[w])
+            .gap_m;
+        biot(p.radius_m[i] - gap, p.radius_m[i])
+    });
+    let contact_max = pairs.chain(walls).fold(0.0, f64::max);
+    let convection_max = sim.gas.as_ref().map_or(0.0, |gas| {
+        (0..p.len())
+            .filter_map(|i| {
+                let (_, conductance) =
+                    gas.convection_conductance(&p.position_m[i], &p.velocity_m_per_s[i], p.radius_m[i])?;
+                let r = p.radius_m[i];
+                let h = conductance / (4.0 * std::f64::consts::PI * r * r);
+                let k_s = sim.config.species.get(p.species[i]).thermal_conductivity_w_per_m_k?;
+                Some(h * r / k_s)
+            })
+            .fold(0.0, f64::max)
+    });
+    Some(BiotNumbers {
+        contact_max,
+        convection_max,
+    })
 }
 
 const SERIES_HEADER: &str = "step,time_s,kinetic_energy_j,translational_kinetic_energy_j,bed_top_m,mean_height_m,pair_contacts,wall_contacts,mean_coordination";
@@ -556,6 +611,7 @@ pub fn run_in_dir(built: &BuiltScenario, out: &Path, ctl: RunControl) -> Result<
         neighbor_refilters: sim.neighbor_refilters(),
         build: crate::provenance::build_id(),
         cpu_path: crate::provenance::cpu_path().to_string(),
+        biot_numbers: biot_numbers(&sim),
     };
     if summary.finished {
         let json = serde_json::to_string_pretty(&summary).expect("summary serialises");

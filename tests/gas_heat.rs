@@ -239,6 +239,17 @@ fn the_gas_temperature_restarts_exactly() {
     let (whole, split) = (final_state(&dir.join("whole")), final_state(&dir.join("split")));
     assert_eq!(whole.step, 5000);
     assert_eq!(whole.gas.as_ref().unwrap().scalars.len(), 1);
+    // The summary reports the lumped-particle check (seed 000 §5.1.3): both Biot numbers small.
+    let summary: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("whole/summary.json")).expect("summary")).expect("json");
+    let biot = &summary["biot_numbers"];
+    let (contact, convection) = (
+        biot["contact_max"].as_f64().unwrap(),
+        biot["convection_max"].as_f64().unwrap(),
+    );
+    println!("closed box: Biot numbers contact {contact:.3e}, convection {convection:.3e}");
+    assert!((0.0..0.1).contains(&contact), "{contact}");
+    assert!(convection > 0.0 && convection < 0.01, "{convection}");
     if let Some(diff) = first_difference(&whole, &split) {
         panic!("the resumed run differs from the uninterrupted one: {diff}");
     }

@@ -331,6 +331,14 @@ fn a_closed_drum_keeps_its_energy_and_the_same_bits_on_any_thread_count_and_acro
     let (whole, split) = (final_state(&dir.join("whole")), final_state(&dir.join("split")));
     assert_eq!(whole.step, 3000);
     assert_eq!(whole.particles.temperature_k.len(), whole.particles.len());
+    // The summary's lumped-particle check (seed 000 eq. 5.15): (2/π) √(δ/R) of the deepest contact, small.
+    let summary: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("whole/summary.json")).expect("summary")).expect("json");
+    let contact = summary["biot_numbers"]["contact_max"]
+        .as_f64()
+        .expect("a contact Biot number");
+    println!("drum: contact Biot number {contact:.3e}");
+    assert!(contact > 0.0 && contact < 0.2, "{contact}");
     if let Some(diff) = first_difference(&whole, &split) {
         panic!("the resumed run differs from the uninterrupted one: {diff}");
     }
