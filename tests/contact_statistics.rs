@@ -6,10 +6,8 @@
 mod common;
 
 use std::f64::consts::PI;
-use std::path::Path;
 
-use common::{built, granflow, simulation};
-use granflow::checkpoint::CheckpointSeries;
+use common::{built, simulation, whole_and_resumed};
 use granflow::engine::state::{SimState, first_difference};
 
 /// Hertz's elastic contact time t_c = 2.87 (m*²/(R* E*² v))^{1/5}.
@@ -105,15 +103,6 @@ output: { checkpoint_every_steps: 500, keep_checkpoints: 2, series_every_steps: 
 seed: 3
 "#;
 
-fn final_state(dir: &Path) -> SimState {
-    let series = CheckpointSeries::new(dir, 2);
-    series
-        .latest_valid()
-        .expect("lists")
-        .expect("a checkpoint exists")
-        .state
-}
-
 /// The channels and the contacts' durations are the same bits on 1, 2 and 3 threads (and on unequal ranges), and
 /// a run stopped half-way and resumed in a fresh process ends with the same bits as an uninterrupted one.
 #[test]
@@ -157,29 +146,7 @@ fn contact_statistics_are_the_same_bits_on_any_thread_count_and_across_a_restart
 
     let tmp = tempfile::tempdir().expect("temp dir");
     let dir = tmp.path();
-    std::fs::write(dir.join("drum.yaml"), DRUM).expect("write scenario");
-    let run = |args: &[&str]| {
-        let out = granflow(args, dir);
-        assert!(
-            out.status.success(),
-            "{args:?}: {}",
-            String::from_utf8_lossy(&out.stderr)
-        );
-    };
-    run(&["simulate", "drum.yaml", "--out", "whole", "--quiet"]);
-    run(&[
-        "simulate",
-        "drum.yaml",
-        "--out",
-        "split",
-        "--max-steps",
-        "1700",
-        "--threads",
-        "2",
-        "--quiet",
-    ]);
-    run(&["simulate", "drum.yaml", "--out", "split", "--quiet"]);
-    let (whole, split) = (final_state(&dir.join("whole")), final_state(&dir.join("split")));
+    let (whole, split) = whole_and_resumed(dir, DRUM, 1700);
     assert_eq!(whole.step, 3000);
     assert!(whole.particles.channels.is_on());
     if let Some(diff) = first_difference(&whole, &split) {

@@ -5,12 +5,10 @@
 mod common;
 
 use std::f64::consts::PI;
-use std::path::Path;
 
-use common::{built, granflow, simulation};
-use granflow::checkpoint::CheckpointSeries;
+use common::{built, simulation, whole_and_resumed};
 use granflow::engine::Simulation;
-use granflow::engine::state::{SimState, first_difference};
+use granflow::engine::state::first_difference;
 
 /// One sphere of radius 1 mm in a 2 cm box of gas (4 × 4 × 4 cells), no gravity; `gas_sides` and `nusselt` as
 /// given; the gas's heat capacity `gas_c` (a huge one holds the gas at its temperature).
@@ -200,43 +198,13 @@ fn a_heated_wall_heats_the_gas_and_vacuum_switches_the_gas_off() {
     assert_eq!(sim.particles.temperature_k, vec![300.0]);
 }
 
-fn final_state(dir: &Path) -> SimState {
-    CheckpointSeries::new(dir, 2)
-        .latest_valid()
-        .expect("lists")
-        .expect("a checkpoint exists")
-        .state
-}
-
 /// The gas temperature and its pending exchange are in the checkpoint: a run stopped mid-way (between gas steps)
 /// and resumed on another thread count ends with the same bits.
 #[test]
 fn the_gas_temperature_restarts_exactly() {
     let tmp = tempfile::tempdir().expect("temp dir");
     let dir = tmp.path();
-    std::fs::write(dir.join("box.yaml"), CLOSED_BOX).expect("write scenario");
-    let run = |args: &[&str]| {
-        let out = granflow(args, dir);
-        assert!(
-            out.status.success(),
-            "{args:?}: {}",
-            String::from_utf8_lossy(&out.stderr)
-        );
-    };
-    run(&["simulate", "box.yaml", "--out", "whole", "--quiet"]);
-    run(&[
-        "simulate",
-        "box.yaml",
-        "--out",
-        "split",
-        "--max-steps",
-        "2510",
-        "--threads",
-        "2",
-        "--quiet",
-    ]);
-    run(&["simulate", "box.yaml", "--out", "split", "--quiet"]);
-    let (whole, split) = (final_state(&dir.join("whole")), final_state(&dir.join("split")));
+    let (whole, split) = whole_and_resumed(dir, CLOSED_BOX, 2510);
     assert_eq!(whole.step, 5000);
     assert_eq!(whole.gas.as_ref().unwrap().scalars.len(), 1);
     // The summary reports the lumped-particle check (seed 000 §5.1.3): both Biot numbers small.

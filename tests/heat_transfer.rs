@@ -6,10 +6,8 @@
 mod common;
 
 use std::f64::consts::PI;
-use std::path::Path;
 
-use common::{built, granflow, simulation};
-use granflow::checkpoint::CheckpointSeries;
+use common::{built, simulation, whole_and_resumed};
 use granflow::engine::Simulation;
 use granflow::engine::state::{SimState, first_difference};
 
@@ -250,14 +248,6 @@ fn thermal_energy_j(s: &SimState, heat_capacity: f64) -> f64 {
         .sum()
 }
 
-fn final_state(dir: &Path) -> SimState {
-    CheckpointSeries::new(dir, 2)
-        .latest_valid()
-        .expect("lists")
-        .expect("a checkpoint exists")
-        .state
-}
-
 /// The drum keeps its particles' energy Σ m c T to rounding while heat flows between them, and the temperatures
 /// are the same bits on 1, 2 and 3 threads, through the heat pass and the wide pass, and across a restart in a fresh
 /// process.
@@ -306,29 +296,7 @@ fn a_closed_drum_keeps_its_energy_and_the_same_bits_on_any_thread_count_and_acro
 
     let tmp = tempfile::tempdir().expect("temp dir");
     let dir = tmp.path();
-    std::fs::write(dir.join("drum.yaml"), DRUM).expect("write scenario");
-    let run = |args: &[&str]| {
-        let out = granflow(args, dir);
-        assert!(
-            out.status.success(),
-            "{args:?}: {}",
-            String::from_utf8_lossy(&out.stderr)
-        );
-    };
-    run(&["simulate", "drum.yaml", "--out", "whole", "--quiet"]);
-    run(&[
-        "simulate",
-        "drum.yaml",
-        "--out",
-        "split",
-        "--max-steps",
-        "1700",
-        "--threads",
-        "2",
-        "--quiet",
-    ]);
-    run(&["simulate", "drum.yaml", "--out", "split", "--quiet"]);
-    let (whole, split) = (final_state(&dir.join("whole")), final_state(&dir.join("split")));
+    let (whole, split) = whole_and_resumed(dir, DRUM, 1700);
     assert_eq!(whole.step, 3000);
     assert_eq!(whole.particles.temperature_k.len(), whole.particles.len());
     // The summary's lumped-particle check (seed 000 eq. 5.15): (2/π) √(δ/R) of the deepest contact, small.

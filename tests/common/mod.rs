@@ -24,3 +24,45 @@ pub fn granflow(args: &[&str], cwd: &Path) -> Output {
         .output()
         .expect("the granflow binary runs")
 }
+
+/// The newest valid checkpoint's state in a run directory.
+pub fn final_state(dir: &Path) -> granflow::engine::state::SimState {
+    granflow::checkpoint::CheckpointSeries::new(dir, 2)
+        .latest_valid()
+        .expect("lists")
+        .expect("a checkpoint exists")
+        .state
+}
+
+/// Runs the scenario `yaml` through the binary in `dir`: uninterrupted into `whole/`, and into `split/` stopped at
+/// `stop_step` on two threads then resumed in a fresh process; returns the final states (whole, split).
+pub fn whole_and_resumed(
+    dir: &Path,
+    yaml: &str,
+    stop_step: u64,
+) -> (granflow::engine::state::SimState, granflow::engine::state::SimState) {
+    std::fs::write(dir.join("scenario.yaml"), yaml).expect("write scenario");
+    let run = |args: &[&str]| {
+        let out = granflow(args, dir);
+        assert!(
+            out.status.success(),
+            "{args:?}: {}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+    };
+    let stop = stop_step.to_string();
+    run(&["simulate", "scenario.yaml", "--out", "whole", "--quiet"]);
+    run(&[
+        "simulate",
+        "scenario.yaml",
+        "--out",
+        "split",
+        "--max-steps",
+        &stop,
+        "--threads",
+        "2",
+        "--quiet",
+    ]);
+    run(&["simulate", "scenario.yaml", "--out", "split", "--quiet"]);
+    (final_state(&dir.join("whole")), final_state(&dir.join("split")))
+}
