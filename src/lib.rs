@@ -17,6 +17,7 @@ pub mod checkpoint;
 pub mod cli;
 pub mod engine;
 pub mod error;
+pub mod heated_drum;
 pub mod inspect;
 pub mod machine;
 mod models_doc;

@@ -170,6 +170,9 @@ pub fn series_header(built: &BuiltScenario) -> String {
     if built.config.heat.is_some() {
         header.push_str(HEAT_SERIES_COLUMNS);
     }
+    if crate::heated_drum::heated_drum(&built.config).is_some() {
+        header.push_str(crate::heated_drum::DRUM_HEAT_COLUMNS);
+    }
     if built.spec.output.net_forces {
         header.push_str(",weight_n,fluid_force_up_n");
         for wall in &built.config.walls {
@@ -285,7 +288,14 @@ fn series_row(sim: &mut Simulation, built: &BuiltScenario) -> String {
     let (pairs, walls) = sim.contact_counts();
     let n = sim.particles.len().max(1) as f64;
     let gas = gas_columns(sim, built.gas.as_ref().and_then(|g| g.pressure_probe_height_m));
-    let heat = heat_columns(sim);
+    let mut heat = heat_columns(sim);
+    if let (Some(drum), Some(spec)) = (crate::heated_drum::heated_drum(&sim.config), &built.spec.heat) {
+        heat.push_str(&crate::heated_drum::drum_heat_columns(
+            sim,
+            &drum,
+            spec.bed_core_radius_fraction,
+        ));
+    }
     format!(
         "{},{:e},{:e},{:e},{:e},{:e},{},{},{:.6}{gas}{heat}{net}",
         sim.step,

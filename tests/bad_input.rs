@@ -346,6 +346,12 @@ const HEAT_CASES: &[(&str, &str, &str, &[&str])] = &[
         ],
     ),
     (
+        "a bed core wider than the distance to the wall",
+        "  walls: { box_z_lo: { temperature_k: 400.0 } }",
+        "  walls: { box_z_lo: { temperature_k: 400.0 } }\n  bed_core_radius_fraction: 1.5",
+        &["heat.bed_core_radius_fraction", "expected 0 < value <= 1", "got 1.5"],
+    ),
+    (
         "an unknown material",
         "  - { name: glass, radius_m",
         "  - { name: glass, material: granite, radius_m",

@@ -569,6 +569,36 @@ const CASES: &[(&str, &str, &str, &[&str])] = &[
         ],
     ),
     (
+        "wall heat metric without a heated drum",
+        "coordination_number]",
+        "coordination_number, wall_heat_transfer_coefficient_w_per_m2_k]",
+        &[
+            "key `metrics[4]`",
+            "`wall_heat_transfer_coefficient_w_per_m2_k` needs one drum wall held at a temperature",
+            "the scenario has 0",
+        ],
+    ),
+    (
+        "heating fit after the end",
+        "analysis: { mixing_species: red }",
+        "analysis: { mixing_species: red, heating_fit_from_s: 0.5 }",
+        &[
+            "analysis.heating_fit_from_s",
+            "expected 0 <= value < the end time (0.002 s), got 0.5",
+        ],
+    ),
+    (
+        "a misspelt field that the base leaves at its default (not written out)",
+        "  grid:\n",
+        "  grid:\n    - { param: output.net_force, values: [true] }\n",
+        &[
+            "key `sweep.grid[0].param`",
+            "parameter `output.net_force`: the scenario has no `net_force` at `output`",
+            "unknown field `net_force`, expected one of",
+            "`net_forces`",
+        ],
+    ),
+    (
         "cohesion switched off without a cohesion model",
         "  time: {",
         "  cohesion_off: { between_particles: true }\n  time: {",

@@ -10,6 +10,8 @@
 //!   rule (seed 000 §4).
 //! - `escape_velocity`: the head-on escape velocity of a Hamaker pair and the Hamaker constant matching a square
 //!   well (seed 001 ch. 7).
+//! - `wall_heat`: the wall-to-bed heat transfer coefficient h_w of a heated drum, its core temperature and contact
+//!   arc (seed 000 §5.2.4).
 //!
 //! Everything here is a pure function of values passed in: nothing reads checkpoints, the store or the engine's
 //! state directly, and nothing here is called while a simulation steps.
@@ -21,6 +23,7 @@ pub mod fluidization;
 pub mod granular;
 pub mod knn;
 pub mod mixing;
+pub mod wall_heat;
 
 pub use fit::{ExponentialFit, fit_exponential_decay, time_to_fraction_of_max};
 pub use granular::{GranularTemperature, granular_temperature, mean_coordination_number};

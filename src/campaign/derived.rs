@@ -19,6 +19,13 @@ pub enum DerivedSpec {
         /// The sweep parameter (its `name:` or path) holding the superficial inlet velocity, m/s.
         velocity_param: String,
     },
+    /// The convective/conductive split of a heated drum's h_w (seed 000 Fig. 72): (h_w(air) − h_w(vacuum)) /
+    /// h_w(vacuum) from the pair of jobs with and without gas that share every other parameter. Needs the metric
+    /// `wall_heat_transfer_coefficient_w_per_m2_k`.
+    ConvectiveToConductiveRatio {
+        /// The sweep parameter (its `name:` or path) switching the gas off: `gas.vacuum`, true or false.
+        vacuum_param: String,
+    },
 }
 
 impl DerivedSpec {
@@ -30,12 +37,14 @@ impl DerivedSpec {
                 JobMetric::PressureDropStd,
                 JobMetric::BedWeightPerArea,
             ],
+            DerivedSpec::ConvectiveToConductiveRatio { .. } => &[JobMetric::WallHeatTransferCoefficient],
         }
     }
 
     pub fn param(&self) -> &str {
         match self {
             DerivedSpec::MinimumFluidizationVelocity { velocity_param } => velocity_param,
+            DerivedSpec::ConvectiveToConductiveRatio { vacuum_param } => vacuum_param,
         }
     }
 }
@@ -66,9 +75,55 @@ pub fn compute(specs: &[DerivedSpec], header: &[String], rows: &[Vec<Value>]) ->
         .collect();
     let status = column("status");
     let number = |row: &[Value], k: Option<usize>| k.and_then(|k| row[k].as_f64()).unwrap_or(f64::NAN);
+    // Rows with status `done` grouped by every parameter but `except` (canonical JSON of the rest).
+    let groups = |except: &str| -> BTreeMap<String, Vec<&Vec<Value>>> {
+        let mut groups: BTreeMap<String, Vec<&Vec<Value>>> = BTreeMap::new();
+        for row in rows {
+            if status.is_some_and(|s| row[s] != Value::String("done".into())) {
+                continue;
+            }
+            let group: BTreeMap<&str, &Value> = params
+                .iter()
+                .filter(|(_, n)| n != except)
+                .map(|(k, n)| (n.as_str(), &row[*k]))
+                .collect();
+            groups
+                .entry(serde_json::to_string(&group).expect("JSON values serialise"))
+                .or_default()
+                .push(row);
+        }
+        groups
+    };
     let mut out = Vec::new();
     for spec in specs {
         match spec {
+            DerivedSpec::ConvectiveToConductiveRatio { vacuum_param } => {
+                let vacuum = column(&format!("param.{vacuum_param}"));
+                let h_w = metric_column(JobMetric::WallHeatTransferCoefficient);
+                for (group_json, rows) in groups(vacuum_param) {
+                    // The mean h_w of the group's jobs in air and in vacuum (one each in a plain sweep).
+                    let mean_where = |in_vacuum: bool| {
+                        let values: Vec<f64> = rows
+                            .iter()
+                            // The store keeps a boolean parameter as its text.
+                            .filter(|row| {
+                                vacuum.is_some_and(|v| {
+                                    row[v] == Value::Bool(in_vacuum) || row[v] == Value::String(in_vacuum.to_string())
+                                })
+                            })
+                            .map(|row| number(row, h_w))
+                            .collect();
+                        values.iter().sum::<f64>() / values.len() as f64
+                    };
+                    let (air, vacuum) = (mean_where(false), mean_where(true));
+                    out.push(DerivedValue {
+                        group_json,
+                        name: "convective_to_conductive_ratio",
+                        value: (air - vacuum) / vacuum,
+                        unit: "",
+                    });
+                }
+            }
             DerivedSpec::MinimumFluidizationVelocity { velocity_param } => {
                 let u = column(&format!("param.{velocity_param}"));
                 let (mean, std, weight) = (
@@ -126,4 +181,48 @@ pub fn compute(specs: &[DerivedSpec], header: &[String], rows: &[Vec<Value>]) ->
         }
     }
     out
+}
+
+#[cfg(test)]
+mod tests {
+    use serde_json::{Value, json};
+
+    use super::{DerivedSpec, compute};
+
+    /// Each (material, speed) group pairs its air and vacuum jobs; the store keeps the boolean as text; a job that
+    /// did not finish does not count.
+    #[test]
+    fn the_convective_ratio_pairs_air_and_vacuum_jobs_of_a_group() {
+        let header: Vec<String> = [
+            "status",
+            "param.material",
+            "param.vacuum",
+            "metric.wall_heat_transfer_coefficient_w_per_m2_k [W/(m2 K)]",
+        ]
+        .map(String::from)
+        .to_vec();
+        let row = |status: &str, material: &str, vacuum: &str, h: f64| -> Vec<Value> {
+            vec![json!(status), json!(material), json!(vacuum), json!(h)]
+        };
+        let rows = vec![
+            row("done", "glass", "false", 95.0),
+            row("done", "glass", "true", 5.0),
+            row("done", "aluminium", "false", 150.0),
+            row("done", "aluminium", "true", 100.0),
+            row("failed", "aluminium", "true", 1.0),
+        ];
+        let spec = DerivedSpec::ConvectiveToConductiveRatio {
+            vacuum_param: "vacuum".into(),
+        };
+        let out = compute(&[spec], &header, &rows);
+        let value = |material: &str| {
+            out.iter()
+                .find(|d| d.group_json == format!("{{\"material\":\"{material}\"}}"))
+                .map(|d| (d.name, d.value))
+                .unwrap()
+        };
+        assert_eq!(value("glass"), ("convective_to_conductive_ratio", 18.0));
+        assert_eq!(value("aluminium"), ("convective_to_conductive_ratio", 0.5));
+        assert_eq!(out.len(), 2);
+    }
 }

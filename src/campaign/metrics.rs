@@ -15,6 +15,7 @@ use serde::{Deserialize, Deserializer, Serialize, Serializer};
 use super::JobSpec;
 use super::spec::CampaignSpec;
 use crate::engine::models::cohesion_law::{CohesionModel, LiquidBridge};
+use crate::scenario::spec::WallSpec;
 
 /// Declares [`JobMetric`] from its table: `Variant => "name", "unit", [needs], "description";`.
 macro_rules! job_metrics {
@@ -137,6 +138,18 @@ job_metrics! {
         "fraction of the run a particle spends touching a wall, mean over the particles";
     ProbePressureDropMean => "probe_pressure_drop_mean_pa", "Pa", [Gas, PressureProbe],
         "time-averaged pressure drop from the inlet to gas.pressure_probe_height_m";
+    MeanTemperature => "mean_temperature_k", "K", [Heat],
+        "the particles' mass-weighted mean temperature at the end";
+    WallHeatTransferCoefficient => "wall_heat_transfer_coefficient_w_per_m2_k", "W/(m2 K)", [HeatedDrum],
+        "h_w = c_p w (1 - exp(slope t_c))/(A t_c) (seed 000 eq. 5.21): slope of ln((T_w - <T_c>)/(T_w - T_0)) fitted from analysis.heating_fit_from_s (default: when the wall starts heating), <T_c> the core's temperature (heat.bed_core_radius_fraction), w the bed's mass, t_c = arc/omega and A = arc R L from the mean contact arc";
+    WallHeatTransferCoefficientInnerCore => "wall_heat_transfer_coefficient_inner_core_w_per_m2_k", "W/(m2 K)", [HeatedDrum],
+        "the same from the inner core (half the core's radius): seed 000 Fig. 69, the core region changes h_w";
+    CoreHeatingSlope => "core_heating_slope_per_s", "1/s", [HeatedDrum],
+        "the fitted slope of ln((T_w - <T_c>)/(T_w - T_0)) against t (seed 000 eq. 5.19, Fig. 70)";
+    DrumContactArc => "drum_contact_arc_rad", "rad", [HeatedDrum],
+        "the angle of drum wall the bed touches, mean over the fit window";
+    DrumWallContactTime => "drum_wall_contact_time_s", "s", [HeatedDrum],
+        "t_c = arc/omega: how long a point of the wall stays under the bed (seed 000 eq. 5.18 read with the arc in rad and the speed in rev/s)";
 }
 
 impl JobMetric {
@@ -195,6 +208,10 @@ pub enum Need {
     NetForces,
     /// `output.contact_statistics` (contact durations and wall contact times).
     ContactStatistics,
+    /// A `heat` section (particle temperatures).
+    Heat,
+    /// A `heat` section and one drum wall held at a temperature (a kiln).
+    HeatedDrum,
 }
 
 impl Need {
@@ -210,6 +227,8 @@ impl Need {
             Need::Spray => "a spray",
             Need::NetForces => "output.net_forces",
             Need::ContactStatistics => "output.contact_statistics",
+            Need::Heat => "heat transfer",
+            Need::HeatedDrum => "a heated drum",
         }
     }
 
@@ -259,6 +278,29 @@ impl Need {
                 scenario.output.contact_statistics,
                 format!("`{name}` needs `output.contact_statistics: true` (contact durations and wall contact times)"),
             ),
+            Need::Heat => unless(
+                scenario.heat.is_some(),
+                format!("`{name}` needs heat transfer (a `heat:` section in the scenario)"),
+            ),
+            Need::HeatedDrum => {
+                let heated = scenario.heat.as_ref().map_or(0, |heat| {
+                    scenario
+                        .walls
+                        .iter()
+                        .filter(|w| match w {
+                            WallSpec::Drum(d) => heat.walls.get(&d.name).is_some_and(|h| h.temperature_k.is_some()),
+                            _ => false,
+                        })
+                        .count()
+                });
+                unless(
+                    heated == 1,
+                    format!(
+                        "`{name}` needs one drum wall held at a temperature (`heat.walls.<drum>.temperature_k`); the \
+                         scenario has {heated}"
+                    ),
+                )
+            }
         }
     }
 }
@@ -308,6 +350,17 @@ pub fn check(spec: &CampaignSpec) -> Result<Vec<JobMetric>, (String, String)> {
     {
         return Err((
             "analysis.mixing_fit_from_s".into(),
+            format!(
+                "expected 0 <= value < the end time ({} s), got {t}",
+                spec.base.time.end_time_s
+            ),
+        ));
+    }
+    if let Some(t) = spec.analysis.heating_fit_from_s
+        && !(t.is_finite() && t >= 0.0 && t < spec.base.time.end_time_s)
+    {
+        return Err((
+            "analysis.heating_fit_from_s".into(),
             format!(
                 "expected 0 <= value < the end time ({} s), got {t}",
                 spec.base.time.end_time_s

@@ -348,6 +348,9 @@ fn resolve(
 ) -> Result<JobSpec, ConfigError> {
     let mut doc = base.clone();
     let mut seen_paths: Vec<&str> = Vec::new();
+    // Parameters whose last key the base left out (a field at its default): path, key in the campaign file, and
+    // the message should the scenario not know the key.
+    let mut inserted: Vec<(String, &str, String)> = Vec::new();
     for (param, value) in &point {
         let key = param_keys.get(param).map_or("sweep", String::as_str);
         if seen_paths.contains(&param.as_str()) {
@@ -369,11 +372,28 @@ fn resolve(
         if let (Some(section), serde_json::Value::Object(map)) = (optional_section(param), &mut doc) {
             map.entry(section).or_insert(serde_json::Value::Null);
         }
-        sweep::set_path_with_sections(&mut doc, param, value.clone(), optional_sections())
+        let added = sweep::set_path_with_sections(&mut doc, param, value.clone(), optional_sections(), true)
             .map_err(|m| invalid(path, key, format!("parameter `{param}`: {m}")))?;
+        if let Some(unknown) = added {
+            inserted.push((
+                sweep::canonical_path(param).unwrap_or_else(|_| param.clone()),
+                key,
+                unknown,
+            ));
+        }
     }
     let mut scenario: ScenarioSpec = serde_path_to_error::deserialize(&doc).map_err(|e| {
         let key = e.path().to_string();
+        // A key the sweep added that the scenario does not know: reported at the sweep's key.
+        if let Some((param, sweep_key, unknown)) = inserted.iter().find(|(p, _, _)| *p == key) {
+            // Without a suggestion from the keys written there, serde's list of every field it knows.
+            let detail = if unknown.contains("did you mean") {
+                unknown.clone()
+            } else {
+                format!("{unknown}; {}", e.inner())
+            };
+            return invalid(path, *sweep_key, format!("parameter `{param}`: {detail}"));
+        }
         invalid(
             path,
             format!("base.{key}"),

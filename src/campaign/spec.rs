@@ -135,6 +135,9 @@ pub struct AnalysisSpec {
     /// (notes §4.1).
     #[serde(default, skip_serializing_if = "CyclePressure::is_column")]
     pub cycle_pressure: CyclePressure,
+    /// h_w (a heated drum) fits the core's heating from this time on, s (default: when the drum starts heating).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub heating_fit_from_s: Option<f64>,
 }
 
 /// The pressure drop of the cycle metrics; see [`AnalysisSpec::cycle_pressure`].
@@ -168,6 +171,7 @@ impl Default for AnalysisSpec {
             capillary_number_porosity: None,
             mixing_fit_from_s: None,
             cycle_pressure: CyclePressure::Column,
+            heating_fit_from_s: None,
         }
     }
 }

@@ -421,21 +421,27 @@ pub fn canonical_path(path: &str) -> Result<String, String> {
 /// Sets `path` in `doc` to `value`. Every segment must already exist (the base scenario, re-serialised, holds every
 /// field including defaults), so a typo is an error listing what exists there instead of a silently ignored key.
 pub fn set_path(doc: &mut Value, path: &str, value: Value) -> Result<(), String> {
-    set_path_with_sections(doc, path, value, &[])
+    set_path_with_sections(doc, path, value, &[], false).map(|_| ())
 }
 
 /// As [`set_path`]; `optional_sections`: top-level keys a scenario may have that `doc` leaves out (they are listed
-/// and suggested when a top-level key is unknown).
+/// and suggested when a top-level key is unknown). With `insert_missing_last`, a last key that its (existing) map
+/// lacks is added: a field left at its default, which the re-serialised base leaves out (`gas.vacuum`,
+/// `heat.walls.drum.from_s`); the caller's deserialisation of the scenario then refuses a key it does not know.
+/// Returns, when the key was added, the message for a key the scenario turns out not to know (what exists there,
+/// with a did-you-mean).
 pub fn set_path_with_sections(
     doc: &mut Value,
     path: &str,
     value: Value,
     optional_sections: &[String],
-) -> Result<(), String> {
+    insert_missing_last: bool,
+) -> Result<Option<String>, String> {
     let segments = parse_path(path)?;
+    let last = segments.len() - 1;
     let mut here = doc;
     let mut walked = String::new();
-    for seg in segments {
+    for (depth, seg) in segments.into_iter().enumerate() {
         here = match seg {
             Segment::Key(k) => {
                 let Value::Object(map) = here else {
@@ -459,7 +465,7 @@ pub fn set_path_with_sections(
                     let hint = did_you_mean(&k, &known)
                         .map(|s| format!("; did you mean `{s}`?"))
                         .unwrap_or_default();
-                    return Err(format!(
+                    let message = format!(
                         "the scenario has no `{k}` {} (there: {}){hint}",
                         if walked.is_empty() {
                             "at the top level".to_string()
@@ -467,7 +473,12 @@ pub fn set_path_with_sections(
                             format!("at `{walked}`")
                         },
                         known.join(", ")
-                    ));
+                    );
+                    if insert_missing_last && depth == last && !walked.is_empty() {
+                        map.insert(k, value);
+                        return Ok(Some(message));
+                    }
+                    return Err(message);
                 }
                 if !walked.is_empty() {
                     walked.push('.');
@@ -489,7 +500,7 @@ pub fn set_path_with_sections(
         };
     }
     *here = value;
-    Ok(())
+    Ok(None)
 }
 
 /// The value at `path` in `doc`, if there is one.

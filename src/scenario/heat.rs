@@ -45,6 +45,13 @@ pub(super) fn build_heat(
         return Ok(None);
     };
     temperature("heat.initial_temperature_k".into(), heat.initial_temperature_k)?;
+    let core = heat.bed_core_radius_fraction;
+    if !(core.is_finite() && core > 0.0 && core <= 1.0) {
+        return Err(fail(
+            "heat.bed_core_radius_fraction".into(),
+            format!("expected 0 < value <= 1 (of the bed centroid's distance to the drum wall), got {core}"),
+        ));
+    }
     // The gas's properties are checked whether or not the scenario has a gas (a campaign may switch it off).
     let g = &heat.gas;
     for (key, value) in [

@@ -172,6 +172,19 @@ pub struct HeatSpec {
     /// The gas's thermal properties and convection, used when the scenario has a `gas` (not in `vacuum`).
     #[serde(default)]
     pub gas: GasHeatSpec,
+    /// In a drum with a heated wall, the bed's core (whose temperature gives h_w, seed 000 eq. 5.21) is the disc
+    /// round the bed's centroid of this fraction of the centroid's distance to the wall; the series also holds an
+    /// inner core of half the radius (Fig. 69: the core changes h_w). Default 0.5.
+    #[serde(default = "half", skip_serializing_if = "is_half")]
+    pub bed_core_radius_fraction: f64,
+}
+
+fn half() -> f64 {
+    0.5
+}
+
+fn is_half(x: &f64) -> bool {
+    *x == 0.5
 }
 
 /// The gas's energy (seed 000 eq. 5.8) and its convection with the particles (eqs. 5.5–5.7). Defaults: Table 7's

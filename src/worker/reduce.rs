@@ -166,6 +166,8 @@ pub fn metrics(job: &JobSpec, built: &BuiltScenario, sim: &Simulation, series: &
     // The cycle is read once for all the cycle metrics that ask for it.
     let cycle_once = std::cell::OnceCell::new();
     let cycle = || cycle_once.get_or_init(|| cycle(job, built, sim, series)).as_ref();
+    let core_once = std::cell::OnceCell::new();
+    let core = || *core_once.get_or_init(|| wall_heat(job, sim, series, "core_temperature_k"));
     job.metrics
         .iter()
         .map(|&metric| {
@@ -246,6 +248,19 @@ pub fn metrics(job: &JobSpec, built: &BuiltScenario, sim: &Simulation, series: &
                     overshoot_net_force(NetForcePart::SidewallNormalLoad, cycle(), sim, series)
                 }
                 JobMetric::SteppedFluidizationVelocity => stepped_onset_m_per_s(job, built, sim, series),
+                JobMetric::MeanTemperature => {
+                    let p = &sim.particles;
+                    let mass: f64 = p.mass_kg.iter().sum();
+                    p.mass_kg.iter().zip(&p.temperature_k).map(|(m, t)| m * t).sum::<f64>() / mass
+                }
+                JobMetric::WallHeatTransferCoefficient => core().map_or(f64::NAN, |(f, _)| f.coefficient_w_per_m2_k),
+                JobMetric::WallHeatTransferCoefficientInnerCore => {
+                    wall_heat(job, sim, series, "inner_core_temperature_k")
+                        .map_or(f64::NAN, |(f, _)| f.coefficient_w_per_m2_k)
+                }
+                JobMetric::CoreHeatingSlope => core().map_or(f64::NAN, |(f, _)| f.slope_per_s),
+                JobMetric::DrumContactArc => core().map_or(f64::NAN, |(_, arc)| arc),
+                JobMetric::DrumWallContactTime => core().map_or(f64::NAN, |(f, _)| f.contact_time_s),
             };
             Metric {
                 name: metric.name().to_string(),
@@ -538,6 +553,46 @@ fn stepped_onset_m_per_s(job: &JobSpec, built: &BuiltScenario, sim: &Simulation,
         })
         .collect();
     analysis::fluidization::minimum_fluidization(&points).map_or(f64::NAN, |m| m.from_sustained_fluctuations_m_per_s)
+}
+
+/// h_w of the run's heated drum from the series column `core_column` (a core temperature), fitted from
+/// `analysis.heating_fit_from_s` (default: when the wall starts heating) to the end, with T_0 the core's temperature
+/// at the first row from the wall's start, and the contact arc's mean over the fit window (returned beside the fit).
+/// `None` without a heated drum, its columns or enough rows.
+fn wall_heat(
+    job: &JobSpec,
+    sim: &Simulation,
+    series: &Series,
+    core_column: &str,
+) -> Option<(analysis::wall_heat::WallHeatFit, f64)> {
+    let drum = crate::heated_drum::heated_drum(&sim.config)?;
+    let heat = sim.config.heat.as_ref()?;
+    let (t, core, arc) = (
+        series.column("time_s")?,
+        series.column(core_column)?,
+        series.column("drum_contact_arc_rad")?,
+    );
+    let start = (0..t.len()).find(|&k| t[k] >= drum.heated_from_s && core[k].is_finite())?;
+    let from_s = job.analysis.heating_fit_from_s.unwrap_or(drum.heated_from_s);
+    let rows: Vec<usize> = (0..t.len()).filter(|&k| t[k] >= from_s).collect();
+    let arc_rad = mean(&rows.iter().map(|&k| arc[k]).collect::<Vec<_>>());
+    let p = &sim.particles;
+    let bed_mass_kg: f64 = p.mass_kg.iter().sum();
+    let heat_j_per_k: f64 = (0..p.len())
+        .map(|i| p.mass_kg[i] * heat.heat_capacity_j_per_kg_k[p.species[i].index()])
+        .sum();
+    let inputs = analysis::wall_heat::WallHeatInputs {
+        wall_temperature_k: drum.temperature_k,
+        initial_core_temperature_k: core[start],
+        heat_capacity_j_per_kg_k: heat_j_per_k / bed_mass_kg,
+        bed_mass_kg,
+        drum_radius_m: drum.axis.radius_m,
+        drum_length_m: drum.length_m,
+        contact_arc_rad: arc_rad,
+        angular_speed_rad_per_s: drum.angular_speed_rad_per_s,
+    };
+    let (t, core): (Vec<f64>, Vec<f64>) = rows.iter().map(|&k| (t[k], core[k])).unzip();
+    analysis::wall_heat::wall_heat_transfer_coefficient(&t, &core, &inputs).map(|fit| (fit, arc_rad))
 }
 
 /// W/A: the particles' weight over the area of the inlet side (seed 000 eq 2.74).

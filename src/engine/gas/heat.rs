@@ -119,4 +119,19 @@ impl GasCoupling {
                 .sum(),
         )
     }
+
+    /// The gas's mean temperature weighted by its mass in each cell, Σ ε T / Σ ε over the cells outside blocked
+    /// ones, K (`None` without heat).
+    pub fn mean_temperature_k(&self) -> Option<f64> {
+        let heat = self.heat?;
+        let config = &self.solver.config;
+        let t = &self.scalar(heat.temperature).value;
+        let porosity = &self.solver.state.porosity;
+        let (mut sum, mut weight) = (0.0, 0.0);
+        for c in (0..t.len()).filter(|&c| !config.blocked.get(c).copied().unwrap_or(false)) {
+            sum += porosity[c] * t[c];
+            weight += porosity[c];
+        }
+        Some(sum / weight)
+    }
 }
