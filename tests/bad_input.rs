@@ -346,6 +346,15 @@ const HEAT_CASES: &[(&str, &str, &str, &[&str])] = &[
         ],
     ),
     (
+        "a liquid that does not conduct",
+        "  walls: { box_z_lo: { temperature_k: 400.0 } }",
+        "  walls: { box_z_lo: { temperature_k: 400.0 } }\n  liquid_conductivity_w_per_m_k: 0.0",
+        &[
+            "heat.liquid_conductivity_w_per_m_k",
+            "expected a finite value > 0, got 0",
+        ],
+    ),
+    (
         "a bed core wider than the distance to the wall",
         "  walls: { box_z_lo: { temperature_k: 400.0 } }",
         "  walls: { box_z_lo: { temperature_k: 400.0 } }\n  bed_core_radius_fraction: 1.5",

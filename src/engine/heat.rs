@@ -10,6 +10,7 @@
 //! done), so any thread count gives the same bits.
 
 use super::models::PairTable;
+use super::models::bridge_conduction::{BridgeLengthTable, bridge_conductance_w_per_k};
 use super::models::conduction::{ThermalPair, effective_modulus_pa};
 use super::particles::{Particles, SpeciesId, SpeciesTable};
 
@@ -25,6 +26,97 @@ pub struct HeatConfig {
     pub wall_temperature_k: Vec<Option<f64>>,
     /// Per wall: the time from which a heated wall is at its temperature, s (adiabatic before).
     pub wall_heated_from_s: Vec<f64>,
+    /// Conduction through liquid bridges (a run with liquid bridges).
+    pub bridges: Option<BridgeConduction>,
+}
+
+/// Conduction through liquid bridges (seed 000 eqs 7.8–7.11), H_l = k_l V/d²: the liquid's conductivity and the
+/// tables of the bridge length d per species pair (`n × n`, d/R of the first species) and per particle–wall species
+/// pair (the wall a sphere of infinite radius), built where particles of those species can meet.
+#[derive(Debug, Clone, PartialEq)]
+pub struct BridgeConduction {
+    pub liquid_conductivity_w_per_m_k: f64,
+    n_species: usize,
+    pairs: Vec<Option<BridgeLengthTable>>,
+    walls: Vec<Option<BridgeLengthTable>>,
+}
+
+impl BridgeConduction {
+    /// Tables for every pair of `particle_species` and for each of them against every species in `wall_species`
+    /// (indices into `species`). Errors name the pair whose bridges the parabola cannot describe.
+    pub fn new(
+        species: &SpeciesTable,
+        particle_species: &[usize],
+        wall_species: &[usize],
+        liquid_conductivity_w_per_m_k: f64,
+    ) -> Result<BridgeConduction, String> {
+        let n = species.len();
+        let mut pairs = vec![None; n * n];
+        let mut walls = vec![None; n * n];
+        let table = |a: usize, radius_j_m: f64, angle_j_rad: f64| {
+            let sa = &species.species[a];
+            BridgeLengthTable::new(sa.radius_m, radius_j_m, sa.contact_angle_rad, angle_j_rad).ok_or_else(|| {
+                format!(
+                    "no parabolic liquid bridge fits species '{}' (contact angle {} rad)",
+                    sa.name, sa.contact_angle_rad
+                )
+            })
+        };
+        for &a in particle_species {
+            for &b in particle_species {
+                let sb = &species.species[b];
+                pairs[a * n + b] = Some(table(a, sb.radius_m, sb.contact_angle_rad)?);
+            }
+            for &w in wall_species {
+                walls[a * n + w] = Some(table(a, f64::INFINITY, species.species[w].contact_angle_rad)?);
+            }
+        }
+        Ok(BridgeConduction {
+            liquid_conductivity_w_per_m_k,
+            n_species: n,
+            pairs,
+            walls,
+        })
+    }
+
+    /// H_l of a bridge of `volume_m3` between particles of species `a` and `b` at surface gap `gap_m`, W/K.
+    #[inline]
+    pub fn pair_conductance_w_per_k(&self, a: SpeciesId, b: SpeciesId, volume_m3: f64, gap_m: f64) -> f64 {
+        self.pairs[a.index() * self.n_species + b.index()]
+            .as_ref()
+            .map_or(0.0, |t| {
+                bridge_conductance_w_per_k(
+                    self.liquid_conductivity_w_per_m_k,
+                    volume_m3,
+                    t.length_m(volume_m3, gap_m),
+                )
+            })
+    }
+
+    /// H_l of a bridge of `volume_m3` between a particle of species `a` and a wall of species `wall` at gap
+    /// `gap_m`, W/K.
+    #[inline]
+    pub fn wall_conductance_w_per_k(&self, a: SpeciesId, wall: SpeciesId, volume_m3: f64, gap_m: f64) -> f64 {
+        self.walls[a.index() * self.n_species + wall.index()]
+            .as_ref()
+            .map_or(0.0, |t| {
+                bridge_conductance_w_per_k(
+                    self.liquid_conductivity_w_per_m_k,
+                    volume_m3,
+                    t.length_m(volume_m3, gap_m),
+                )
+            })
+    }
+
+    /// The largest H_l/R_i over the tables' nodes, W/(m K) (for the explicit step's bound).
+    fn largest_conductance_per_radius_w_per_m_k(&self) -> f64 {
+        self.pairs
+            .iter()
+            .chain(&self.walls)
+            .flatten()
+            .map(|t| self.liquid_conductivity_w_per_m_k * t.largest_volume_over_length_squared_per_radius())
+            .fold(0.0, f64::max)
+    }
 }
 
 impl HeatConfig {
@@ -71,6 +163,7 @@ impl HeatConfig {
                 .collect(),
             wall_temperature_k,
             wall_heated_from_s,
+            bridges: None,
         }
     }
 
@@ -116,6 +209,11 @@ impl HeatConfig {
         // The geometric radius √(R δ) at the tolerated overlap bounds every law's (the linear spring's corrected
         // radius is the real, stiffer material's and smaller).
         let contact_radius = (largest_radius * max_overlap_fraction * largest_radius).sqrt();
-        13.0 * largest_pair * contact_radius * 2.0 * largest_inverse
+        // A liquid bridge to each partner as well.
+        let largest_bridge = self
+            .bridges
+            .as_ref()
+            .map_or(0.0, |b| b.largest_conductance_per_radius_w_per_m_k() * largest_radius);
+        13.0 * (largest_pair * contact_radius + largest_bridge) * 2.0 * largest_inverse
     }
 }

@@ -442,7 +442,11 @@ impl<'a> Context<'a> {
             if dist2 >= range * range && cohesion_state(hist, k).is_empty() {
                 return None;
             }
-            return Some(self.pair_bond(c, bi, j, vel, d, dist2, reach, hist, k, slot, crossings));
+            let bond = self.pair_bond(c, bi, j, vel, d, dist2, reach, hist, k, slot, crossings);
+            if P::HEAT {
+                flows.heat_flow_w += self.bridge_heat_flow_w(i, bi, j, vel, hist, k, dist2.sqrt() - reach);
+            }
+            return Some(bond);
         }
         let dist = dist2.sqrt();
         let inv_dist = 1.0 / dist;
@@ -492,12 +496,40 @@ impl<'a> Context<'a> {
             None => Some(contact),
             Some(c) => {
                 let bond = self.pair_bond(c, bi, j, vel, d, dist2, reach, hist, k, slot, crossings);
+                if P::HEAT {
+                    flows.heat_flow_w += self.bridge_heat_flow_w(i, bi, j, vel, hist, k, dist - reach);
+                }
                 Some(PairResult {
                     force: contact.force + bond.force,
                     torque_i: contact.torque_i + bond.torque_i,
                     torque_j: contact.torque_j + bond.torque_j,
                 })
             }
+        }
+    }
+
+    /// Conduction through the liquid bridge of local pair slot `k` at surface gap `gap_m`, if the run conducts
+    /// through bridges and the slot holds one: H_l (T_j − T_i) into i (seed 000 eq. 7.8), W.
+    #[allow(clippy::too_many_arguments)]
+    #[inline(always)]
+    fn bridge_heat_flow_w(
+        &self,
+        i: usize,
+        bi: &Body,
+        j: usize,
+        vel: &impl Motion,
+        hist: &ColumnsMut,
+        k: usize,
+        gap_m: f64,
+    ) -> f64 {
+        let Some(bridges) = self.heat.and_then(|h| h.bridges.as_ref()) else {
+            return 0.0;
+        };
+        let volume_m3 = hist.cohesion.bridge_volume_m3[k];
+        if volume_m3 > 0.0 {
+            bridges.pair_conductance_w_per_k(bi.species, self.species[j], volume_m3, gap_m) * (vel.t(j) - vel.t(i))
+        } else {
+            0.0
         }
     }
 
@@ -743,6 +775,16 @@ impl<'a> Context<'a> {
         let bridge = self.bridges.wall.get(slot).unwrap_or(&BridgeConstants::NONE);
         let out = c.force(&bond, &mut state, bridge, self.dt_s);
         hist.cohesion.in_well[k] = state.in_well;
+        if P::HEAT
+            && state.bridge_volume_m3 > 0.0
+            && let Some(bridges) = self.heat.and_then(|h| h.bridges.as_ref())
+            && let Some(wall_temperature_k) = self.wall_temperature_k[w as usize]
+        {
+            // A bridge to a heated wall conducts like one to a particle at the wall's temperature (eq. 7.8).
+            flows.heat_flow_w +=
+                bridges.wall_conductance_w_per_k(self.species[i], wall.species, state.bridge_volume_m3, gap)
+                    * (wall_temperature_k - ti);
+        }
         *crossings += u64::from(out.crossed_well);
         let force = n * out.normal_n + out.tangential_n;
         (contact, Some((force, -(n.cross(&out.tangential_n) * ri))), flows)

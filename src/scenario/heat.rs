@@ -8,8 +8,9 @@ use super::spec::ScenarioSpec;
 use crate::engine::gas::heat::GasThermal;
 use crate::engine::gas::{Boundary, GasScalarSpec, ScalarExchange, ScalarWall};
 use crate::engine::geometry::Wall;
-use crate::engine::heat::HeatConfig;
+use crate::engine::heat::{BridgeConduction, HeatConfig};
 use crate::engine::models::PairTable;
+use crate::engine::models::cohesion_law::CohesionModel;
 use crate::engine::particles::{Particles, SpeciesTable};
 
 /// The run's heat configuration, with `particles.temperature_k` set from the fills (`fill_ends[k]`: one past the
@@ -45,6 +46,13 @@ pub(super) fn build_heat(
         return Ok(None);
     };
     temperature("heat.initial_temperature_k".into(), heat.initial_temperature_k)?;
+    let k_l = heat.liquid_conductivity_w_per_m_k;
+    if !(k_l.is_finite() && k_l > 0.0) {
+        return Err(fail(
+            "heat.liquid_conductivity_w_per_m_k".into(),
+            format!("expected a finite value > 0, got {k_l}"),
+        ));
+    }
     let core = heat.bed_core_radius_fraction;
     if !(core.is_finite() && core > 0.0 && core <= 1.0) {
         return Err(fail(
@@ -155,13 +163,30 @@ pub(super) fn build_heat(
             }
         }
     }
-    let config = HeatConfig::new(
+    let mut config = HeatConfig::new(
         species,
         pair_table,
         heat.soft_contact_correction,
         wall_temperature_k,
         wall_heated_from_s,
     );
+    if let Some(CohesionModel::LiquidBridge(bridge)) = &spec.cohesion {
+        // Tables for the species particles are made of, and for the walls they can bridge to.
+        let particle_species: Vec<usize> = (0..species.len())
+            .filter(|&k| particles.species.iter().any(|id| id.index() == k))
+            .collect();
+        let mut wall_species: Vec<usize> = if bridge.walls {
+            walls.iter().map(|w| w.species.index()).collect()
+        } else {
+            Vec::new()
+        };
+        wall_species.sort_unstable();
+        wall_species.dedup();
+        config.bridges = Some(
+            BridgeConduction::new(species, &particle_species, &wall_species, k_l)
+                .map_err(|m| fail("cohesion.liquid_bridge".into(), m))?,
+        );
+    }
     let rate_per_s = config.fastest_relaxation_per_s(particles, spec.max_overlap_fraction);
     if dt_s * rate_per_s >= 1.0 {
         return Err(fail(

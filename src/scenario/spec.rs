@@ -177,6 +177,18 @@ pub struct HeatSpec {
     /// inner core of half the radius (Fig. 69: the core changes h_w). Default 0.5.
     #[serde(default = "half", skip_serializing_if = "is_half")]
     pub bed_core_radius_fraction: f64,
+    /// k_l of the liquid in liquid bridges, W/(m K): bridges conduct H_l = k_l V/d² (seed 000 eqs 7.8–7.11).
+    /// Default 0.61, water near 300 K (the seed gives no value).
+    #[serde(default = "water_conductivity", skip_serializing_if = "is_water_conductivity")]
+    pub liquid_conductivity_w_per_m_k: f64,
+}
+
+fn water_conductivity() -> f64 {
+    0.61
+}
+
+fn is_water_conductivity(x: &f64) -> bool {
+    *x == 0.61
 }
 
 fn half() -> f64 {

@@ -1,6 +1,7 @@
 //! Contact models: each slot is a closed enum of named variants with typed parameters and pure kernels, tested
 //! beside them. Cohesion, liquid bridges, drag, heat and mass transfer join here in later issues.
 
+pub mod bridge_conduction;
 pub mod capillary;
 pub mod capillary_cache;
 pub mod capillary_table;
