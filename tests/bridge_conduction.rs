@@ -4,7 +4,7 @@
 
 mod common;
 
-use common::{built, simulation, whole_and_resumed};
+use common::{built, simulation, thermal_energy_j, whole_and_resumed};
 use granflow::engine::models::liquid_transfer::ParabolicBridge;
 use granflow::engine::state::{SimState, first_difference};
 
@@ -101,20 +101,11 @@ output: { checkpoint_every_steps: 500, keep_checkpoints: 2, series_every_steps: 
 seed: 3
 "#;
 
-fn thermal_energy_j(s: &SimState) -> f64 {
-    s.particles
-        .mass_kg
-        .iter()
-        .zip(&s.particles.temperature_k)
-        .map(|(m, t)| m * HEAT_CAPACITY * t)
-        .sum()
-}
-
 #[test]
 fn a_wet_drum_keeps_its_energy_and_the_same_bits_on_any_thread_count_and_across_a_restart() {
     let b = built(WET_DRUM);
     assert!(b.config.heat.as_ref().is_some_and(|h| h.bridges.is_some()));
-    let before = thermal_energy_j(&simulation(&b, 1).snapshot());
+    let before = thermal_energy_j(&simulation(&b, 1).snapshot(), HEAT_CAPACITY);
     let states: Vec<SimState> = [1, 2]
         .iter()
         .map(|&threads| {
@@ -129,7 +120,7 @@ fn a_wet_drum_keeps_its_energy_and_the_same_bits_on_any_thread_count_and_across_
         .iter()
         .filter(|(_, _, h)| h.cohesion.bridge_volume_m3 > 0.0)
         .count();
-    let after = thermal_energy_j(&states[0]);
+    let after = thermal_energy_j(&states[0], HEAT_CAPACITY);
     println!("wet drum: {bridges} bridges, energy drift {:.2e}", after / before - 1.0);
     assert!(bridges > 100, "bridges formed");
     assert!((after / before - 1.0).abs() < 1e-12, "energy {before} -> {after}");

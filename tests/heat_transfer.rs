@@ -7,7 +7,7 @@ mod common;
 
 use std::f64::consts::PI;
 
-use common::{built, simulation, whole_and_resumed};
+use common::{built, simulation, thermal_energy_j, whole_and_resumed};
 use granflow::engine::Simulation;
 use granflow::engine::state::{SimState, first_difference};
 
@@ -238,15 +238,6 @@ heat: { initial_temperature_k: 300.0, walls: { drum: { adiabatic: true } } }
 output: { checkpoint_every_steps: 500, keep_checkpoints: 2, series_every_steps: 100 }
 seed: 3
 "#;
-
-fn thermal_energy_j(s: &SimState, heat_capacity: f64) -> f64 {
-    s.particles
-        .mass_kg
-        .iter()
-        .zip(&s.particles.temperature_k)
-        .map(|(m, t)| m * heat_capacity * t)
-        .sum()
-}
 
 /// The drum keeps its particles' energy Σ m c T to rounding while heat flows between them, and the temperatures
 /// are the same bits on 1, 2 and 3 threads, through the heat pass and the wide pass, and across a restart in a fresh

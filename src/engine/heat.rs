@@ -82,30 +82,26 @@ impl BridgeConduction {
     /// H_l of a bridge of `volume_m3` between particles of species `a` and `b` at surface gap `gap_m`, W/K.
     #[inline]
     pub fn pair_conductance_w_per_k(&self, a: SpeciesId, b: SpeciesId, volume_m3: f64, gap_m: f64) -> f64 {
-        self.pairs[a.index() * self.n_species + b.index()]
-            .as_ref()
-            .map_or(0.0, |t| {
-                bridge_conductance_w_per_k(
-                    self.liquid_conductivity_w_per_m_k,
-                    volume_m3,
-                    t.length_m(volume_m3, gap_m),
-                )
-            })
+        self.conductance_w_per_k(&self.pairs[a.index() * self.n_species + b.index()], volume_m3, gap_m)
     }
 
     /// H_l of a bridge of `volume_m3` between a particle of species `a` and a wall of species `wall` at gap
     /// `gap_m`, W/K.
     #[inline]
     pub fn wall_conductance_w_per_k(&self, a: SpeciesId, wall: SpeciesId, volume_m3: f64, gap_m: f64) -> f64 {
-        self.walls[a.index() * self.n_species + wall.index()]
-            .as_ref()
-            .map_or(0.0, |t| {
-                bridge_conductance_w_per_k(
-                    self.liquid_conductivity_w_per_m_k,
-                    volume_m3,
-                    t.length_m(volume_m3, gap_m),
-                )
-            })
+        self.conductance_w_per_k(&self.walls[a.index() * self.n_species + wall.index()], volume_m3, gap_m)
+    }
+
+    /// H_l through `table`'s bridge length (0 without a table).
+    #[inline(always)]
+    fn conductance_w_per_k(&self, table: &Option<BridgeLengthTable>, volume_m3: f64, gap_m: f64) -> f64 {
+        table.as_ref().map_or(0.0, |t| {
+            bridge_conductance_w_per_k(
+                self.liquid_conductivity_w_per_m_k,
+                volume_m3,
+                t.length_m(volume_m3, gap_m),
+            )
+        })
     }
 
     /// The largest H_l/R_i over the tables' nodes, W/(m K) (for the explicit step's bound).

@@ -66,3 +66,13 @@ pub fn whole_and_resumed(
     run(&["simulate", "scenario.yaml", "--out", "split", "--quiet"]);
     (final_state(&dir.join("whole")), final_state(&dir.join("split")))
 }
+
+/// The particles' thermal energy Σ m c T of a state whose particles share one heat capacity, J.
+pub fn thermal_energy_j(s: &granflow::engine::state::SimState, heat_capacity_j_per_kg_k: f64) -> f64 {
+    s.particles
+        .mass_kg
+        .iter()
+        .zip(&s.particles.temperature_k)
+        .map(|(m, t)| m * heat_capacity_j_per_kg_k * t)
+        .sum()
+}
