@@ -38,7 +38,7 @@ pub fn cap_fraction_below(s: f64) -> f64 {
 
 /// Cell index along `axis` of coordinate `x` (clamped or wrapped).
 fn cell_along(grid: &Grid, axis: usize, x: f64) -> isize {
-    ((x - grid.origin_m[axis]) / grid.h_m[axis]).floor() as isize
+    floor_to_isize((x - grid.origin_m[axis]) / grid.h_m[axis])
 }
 
 fn wrap_or_clamp(grid: &Grid, axis: usize, i: isize) -> usize {
@@ -129,7 +129,7 @@ pub struct FaceLattice {
 }
 
 /// Up to 8 faces (flat indices into the component's array) with non-zero trilinear weights, in corner order.
-#[derive(Debug, Clone, Copy)]
+#[derive(Debug, Clone, Copy, Default)]
 pub struct Stencil {
     pub face: [usize; 8],
     pub weight: [f64; 8],
@@ -164,48 +164,57 @@ impl FaceLattice {
 
     /// The trilinear stencil at `x`: clamped at non-periodic edges (a point beyond the last face takes that face),
     /// wrapped on periodic axes.
+    ///
+    /// The corners come in the order of a three-bit counter (axis 0 fastest), each with the weight
+    /// ((1 · f_0) · f_1) · f_2 (f_a the axis's w or 1 − w), and a corner of weight 0 is left out: an axis whose upper
+    /// weight is 0 (a clamped edge, a one-cell axis, a point exactly on a face) contributes its lower side alone, so a
+    /// 2-D grid's stencil is built from four corners, not eight.
     #[inline]
     pub fn stencil(&self, x: &Vec3) -> Stencil {
+        // Per axis: the lower and upper face's index times the stride, and their weights 1 − w and w.
         let mut lo = [0usize; 3];
         let mut hi = [0usize; 3];
         let mut w = [0.0f64; 3];
         for a in 0..3 {
             let s = (x[a] - self.origin_m[a]) * self.inverse_h_per_m[a] - self.offset[a];
-            let base = s.floor();
-            let frac = s - base;
-            let base = base as isize;
-            if self.periodic[a] {
+            let base = floor_to_isize(s);
+            let frac = s - base as f64;
+            let (l, h, weight) = if self.periodic[a] {
                 // Faces across a periodic axis number n (the high side is the low side).
                 let n = self.dims[a] as isize - isize::from(a == self.axis);
-                (lo[a], hi[a], w[a]) = (wrap(base, n), wrap(base + 1, n), frac);
+                (wrap(base, n), wrap(base + 1, n), frac)
             } else {
                 let max = self.dims[a] as isize - 1;
-                (lo[a], hi[a], w[a]) = if base < 0 {
+                if base < 0 {
                     (0, 0, 0.0)
                 } else if base >= max {
                     (max as usize, max as usize, 0.0)
                 } else {
                     (base as usize, base as usize + 1, frac)
-                };
-            }
+                }
+            };
+            (lo[a], hi[a], w[a]) = (l * self.stride[a], h * self.stride[a], weight);
         }
         let mut out = Stencil {
             face: [0; 8],
             weight: [0.0; 8],
             count: 0,
         };
-        for corner in 0..8 {
-            let mut face = 0;
-            let mut weight = 1.0;
-            for a in 0..3 {
-                let upper = corner >> a & 1 == 1;
-                face += self.stride[a] * if upper { hi[a] } else { lo[a] };
-                weight *= if upper { w[a] } else { 1.0 - w[a] };
-            }
-            if weight != 0.0 {
-                out.face[out.count] = face;
-                out.weight[out.count] = weight;
-                out.count += 1;
+        // Whether each axis has an upper corner of non-zero weight (1 − w is never 0: w < 1).
+        let upper = w.map(|w| w != 0.0);
+        for k in 0..=usize::from(upper[2]) {
+            let (face_k, weight_k) = if k == 1 { (hi[2], w[2]) } else { (lo[2], 1.0 - w[2]) };
+            for j in 0..=usize::from(upper[1]) {
+                let (face_j, weight_j) = if j == 1 { (hi[1], w[1]) } else { (lo[1], 1.0 - w[1]) };
+                for i in 0..=usize::from(upper[0]) {
+                    let (face_i, weight_i) = if i == 1 { (hi[0], w[0]) } else { (lo[0], 1.0 - w[0]) };
+                    let weight = 1.0 * weight_i * weight_j * weight_k;
+                    if weight != 0.0 {
+                        out.face[out.count] = face_i + face_j + face_k;
+                        out.weight[out.count] = weight;
+                        out.count += 1;
+                    }
+                }
             }
         }
         out
@@ -216,6 +225,16 @@ impl FaceLattice {
     pub fn interpolate(&self, values: &[f64], x: &Vec3) -> f64 {
         self.stencil(x).apply(values)
     }
+}
+
+/// ⌊s⌋ as an integer, exactly `s.floor() as isize` for every `s` (0 for NaN, saturated beyond isize's range), without
+/// the call to the C library's `floor` that the x86-64 baseline makes (it has no rounding instruction): that call
+/// was 6 % of a coupled bed's run (`docs/performance.md`).
+#[inline]
+pub(crate) fn floor_to_isize(s: f64) -> isize {
+    let truncated = s as isize;
+    // Saturating, as the cast is: below isize::MIN the truncation already saturated.
+    truncated.saturating_sub(isize::from((truncated as f64) > s))
 }
 
 /// `i` wrapped into [0, n) (positions on a periodic axis are within one period of the domain, so the division is
@@ -264,6 +283,32 @@ mod tests {
             h_m: [0.01, 0.012, 0.009],
             origin_m: [0.0, -0.02, 0.0],
             boundary: [x, x, wall, wall, wall, wall],
+        }
+    }
+
+    #[test]
+    fn the_integer_floor_is_the_library_floor() {
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(7);
+        let special = [
+            0.0,
+            -0.0,
+            1.0,
+            -1.0,
+            0.5,
+            -0.5,
+            -1e-300,
+            1e-300,
+            4503599627370495.5,
+            -4503599627370495.5,
+            9.3e18,
+            -9.3e18,
+            f64::INFINITY,
+            f64::NEG_INFINITY,
+            f64::NAN,
+        ];
+        let random = (0..10_000).map(|_| rng.random_range(-1e6..1e6));
+        for s in special.into_iter().chain(random) {
+            assert_eq!(floor_to_isize(s), s.floor() as isize, "{s}");
         }
     }
 

@@ -15,7 +15,7 @@ use std::f64::consts::PI;
 
 use serde::{Deserialize, Serialize};
 
-use super::coupling::FaceLattice;
+use super::coupling::{FaceLattice, Stencil, floor_to_isize};
 use super::exchange_accumulator::ExchangeAccumulator;
 use super::grid::Grid;
 use crate::engine::Vec3;
@@ -47,19 +47,24 @@ pub enum DragVelocities {
     CellAveraged,
 }
 
-/// Each particle's drag record of one step.
+/// Each particle's drag record of one step: the drag, its coefficient K and the particle velocity used.
 type DragRecord = (Vec3, f64, Vec3);
+
+/// The same with the interpolation's stencils of the velocity components, which spread the reaction (instantaneous
+/// velocities): computed once per particle and step, not again for the scatter.
+type StencilDragRecord = (DragRecord, [Stencil; 3]);
 
 /// Runs `compute` for every particle (index, its drag record, its force), on `team` when given (a few contiguous
 /// blocks of particles per thread). Particles are independent, so the result is the same on any thread count.
-fn per_particle<F>(team: Option<&Team>, drag: &mut [DragRecord], force: &mut [Vec3], compute: F)
+fn per_particle<R, F>(team: Option<&Team>, drag: &mut [R], force: &mut [Vec3], compute: F)
 where
-    F: Fn((usize, (&mut DragRecord, &mut Vec3))) + Sync + Send,
+    R: Send,
+    F: Fn((usize, (&mut R, &mut Vec3))) + Sync + Send,
 {
     match team {
         Some(team) if team.size() > 1 => {
             let block = drag.len().div_ceil(4 * team.size()).max(1);
-            let parts: Vec<(usize, &mut [DragRecord], &mut [Vec3])> = drag
+            let parts: Vec<(usize, &mut [R], &mut [Vec3])> = drag
                 .chunks_mut(block)
                 .zip(force.chunks_mut(block))
                 .enumerate()
@@ -107,8 +112,10 @@ pub struct FluidForces {
 /// Per-step scratch arrays, kept between steps to avoid allocations.
 #[derive(Debug, Clone, Default)]
 struct Workspace {
-    /// Each particle's drag of the current step, its coefficient K and the particle velocity used.
+    /// Each particle's drag of the current step, its coefficient K and the particle velocity used (cell-averaged
+    /// velocities), or the same with the particle's stencils (instantaneous).
     drag: Vec<DragRecord>,
+    stencil_drag: Vec<StencilDragRecord>,
     /// Each particle's cell.
     cell: Vec<usize>,
     /// Per cell (cell-averaged drag): particle volume, Σ V v, the slip, K of the first particle's radius, Σ drag,
@@ -184,7 +191,7 @@ impl FluidForces {
     pub(crate) fn cell_of(&self, x: &Vec3) -> usize {
         let grid = &self.grid;
         grid.cell(std::array::from_fn(|a| {
-            let c = ((x[a] - grid.origin_m[a]) * self.inverse_h_per_m[a]).floor() as isize;
+            let c = floor_to_isize((x[a] - grid.origin_m[a]) * self.inverse_h_per_m[a]);
             let n = grid.n[a] as isize;
             if (0..n).contains(&c) {
                 c as usize
@@ -358,8 +365,9 @@ impl FluidForces {
         })
     }
 
-    /// The drag, its coefficient K and the total fluid force on particle i (instantaneous velocities).
-    fn instantaneous_force(&self, x: &Vec3, v: &Vec3, r: f64) -> (Vec3, f64, Vec3) {
+    /// The drag, its coefficient K and the total fluid force on particle i (instantaneous velocities), with the
+    /// stencils of the velocity components at `x` in `stencils`.
+    fn instantaneous_force(&self, x: &Vec3, v: &Vec3, r: f64, stencils: &mut [Stencil; 3]) -> (Vec3, f64, Vec3) {
         let volume = 4.0 / 3.0 * PI * r * r * r;
         let eps = self.porosity[self.cell_of(x)];
         let mut u = Vec3::zeros();
@@ -368,6 +376,7 @@ impl FluidForces {
             let stencil = self.lattice[a].stencil(x);
             u[a] = stencil.apply(&self.velocity_m_per_s[a]);
             grad[a] = stencil.apply(&self.minus_pressure_gradient_pa_per_m[a]);
+            stencils[a] = stencil;
         }
         let slip = u - v;
         let k = self.drag.coefficient_n_s_per_m(&DragInput {
@@ -391,19 +400,20 @@ impl FluidForces {
     ) {
         // Per-particle forces are independent (any thread count gives the same bits); the reaction is then
         // scattered serially in particle order, with the interpolation's weights.
-        let mut drag = std::mem::take(&mut self.workspace.drag);
-        drag.resize(positions_m.len(), (Vec3::zeros(), 0.0, Vec3::zeros()));
+        let mut drag = std::mem::take(&mut self.workspace.stencil_drag);
+        drag.resize(positions_m.len(), Default::default());
         let this = &*self;
-        let compute = |(i, (d, f)): (usize, (&mut DragRecord, &mut Vec3))| {
-            let (dr, k, total) = this.instantaneous_force(&positions_m[i], &velocities_m_per_s[i], radii_m[i]);
-            *d = (dr, k, velocities_m_per_s[i]);
+        let compute = |(i, (d, f)): (usize, (&mut StencilDragRecord, &mut Vec3))| {
+            let (record, stencils) = d;
+            let (dr, k, total) =
+                this.instantaneous_force(&positions_m[i], &velocities_m_per_s[i], radii_m[i], stencils);
+            *record = (dr, k, velocities_m_per_s[i]);
             *f += total;
         };
         per_particle(team, &mut drag, force, compute);
         let per_volume = 1.0 / self.grid.cell_volume_m3();
-        for (x, (d, k, v)) in positions_m.iter().zip(&drag) {
-            for a in 0..self.grid.axes() {
-                let stencil = self.lattice[a].stencil(x);
+        for ((d, k, v), stencils) in &drag {
+            for (a, stencil) in stencils.iter().enumerate().take(self.grid.axes()) {
                 let exchange = &mut self.momentum_exchange[a];
                 for c in 0..stencil.count {
                     let (face, w) = (stencil.face[c], stencil.weight[c] * per_volume);
@@ -412,7 +422,7 @@ impl FluidForces {
                 }
             }
         }
-        self.workspace.drag = drag;
+        self.workspace.stencil_drag = drag;
     }
 
     /// The mean reaction per unit volume over the DEM steps since the last freeze (the gas's momentum source).

@@ -11,6 +11,7 @@ pub mod fluid_forces;
 pub mod grid;
 pub mod heat;
 pub mod linsolve;
+pub(crate) mod momentum_rows;
 pub mod scalar;
 pub mod simple;
 pub mod transported_scalar;

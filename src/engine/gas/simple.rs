@@ -20,6 +20,7 @@ use super::linsolve::{
     NEIGHBOURS, NONE, PressureSolver, SolveReport, StencilSystem, bandwidth, bicgstab, conjugate_gradient,
     direct_symmetric,
 };
+use super::momentum_rows::{Across, MomentumRow, NeighbourFace, momentum_rows};
 
 /// The convection scheme.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, schemars::JsonSchema)]
@@ -194,7 +195,7 @@ impl GasState {
 }
 
 /// Index arithmetic with periodic wrapping: `i + delta` along `axis`, or `None` outside a non-periodic grid.
-fn step_cell(grid: &Grid, mut i: [usize; 3], axis: usize, delta: isize) -> Option<[usize; 3]> {
+pub(crate) fn step_cell(grid: &Grid, mut i: [usize; 3], axis: usize, delta: isize) -> Option<[usize; 3]> {
     let n = grid.n[axis] as isize;
     let j = i[axis] as isize + delta;
     if (0..n).contains(&j) {
@@ -225,8 +226,6 @@ fn side_velocity(b: Boundary, inflow_factor: f64) -> [f64; 3] {
 pub struct GasSolver {
     pub config: GasConfig,
     pub state: GasState,
-    /// Per velocity component and face: the unknown's index in that component's system, or NONE (boundary/alias).
-    unknown: [Vec<u32>; 3],
     /// Per component: the face of each unknown.
     face_of: [Vec<usize>; 3],
     /// Per component and face: ε_f A / a_P of the last momentum assembly (the pressure-correction coefficient).
@@ -236,6 +235,48 @@ pub struct GasSolver {
     plenum: [Vec<bool>; 3],
     /// The inflow ramp's factor at the end of the current step (1 without a ramp).
     inflow_factor: f64,
+    /// Per component: the index work of each unknown's momentum row, done when the solver is built (the grid, its
+    /// blocked cells and boundaries do not change after).
+    rows: [Vec<MomentumRow>; 3],
+    /// Per cell (in cell order), its faces along each axis, low side first: see [`PressureSide`].
+    pressure_sides: Vec<PressureSide>,
+}
+
+/// One face of a cell in the pressure-correction equation: the face (of the component along its axis) and, where
+/// the face's velocity is solved and a cell lies beyond it, the solved copy of the face (the first face stands for
+/// the last on a periodic axis) and that cell.
+#[derive(Debug, Clone, Copy)]
+struct PressureSide {
+    face: usize,
+    solved: Option<(usize, usize)>,
+}
+
+/// The faces of every cell for [`PressureSide`], computed once.
+fn pressure_sides(grid: &Grid, unknown: &[Vec<u32>; 3]) -> Vec<PressureSide> {
+    let mut sides = Vec::with_capacity(grid.cells() * 2 * grid.axes());
+    for idx in all_indices(grid.n) {
+        for a in 0..grid.axes() {
+            for high in [false, true] {
+                let mut fi = idx;
+                fi[a] += usize::from(high);
+                let face = grid.face(a, fi);
+                let solved_face = if grid.periodic(a) && fi[a] == grid.n[a] {
+                    let mut first = fi;
+                    first[a] = 0;
+                    grid.face(a, first)
+                } else {
+                    face
+                };
+                let solved = if unknown[a][solved_face] != NONE {
+                    step_cell(grid, idx, a, if high { 1 } else { -1 }).map(|nb| (solved_face, grid.cell(nb)))
+                } else {
+                    None
+                };
+                sides.push(PressureSide { face, solved });
+            }
+        }
+    }
+    sides
 }
 
 impl GasSolver {
@@ -292,14 +333,26 @@ impl GasSolver {
             }
             plenum[f.axis][f.face] = true;
         }
+        let rows = std::array::from_fn(|c| {
+            momentum_rows(
+                grid,
+                &config.blocked,
+                config.blocked_wall_motion,
+                &unknown[c],
+                &face_of[c],
+                c,
+            )
+        });
+        let pressure_sides = pressure_sides(grid, &unknown);
         let mut solver = GasSolver {
             state: GasState::new(grid),
+            pressure_sides,
             config,
-            unknown,
             face_of,
             d,
             plenum,
             inflow_factor: 1.0,
+            rows,
         };
         solver.inflow_factor = solver.inflow_factor_at(solver.state.time_s);
         solver.apply_boundary_velocities();
@@ -466,9 +519,10 @@ impl GasSolver {
         let eps = &self.state.porosity;
         let p = &self.state.pressure_pa;
         let volume = grid.cell_volume_m3();
-        let n_unknowns = self.face_of[c].len();
-        let mut sys = StencilSystem::new(n_unknowns);
-        let mut d = vec![0.0; grid.faces(c)];
+        let rows = &self.rows[c];
+        let mut sys = StencilSystem::new(rows.len());
+        // Only the unknowns' entries are written; the others stay 0 from `new`.
+        let mut d = std::mem::take(&mut self.d[c]);
         let coefficient = |flux_into: f64, diff: f64| -> f64 {
             // flux_into > 0: flow from the neighbour into the control volume.
             match cfg.convection {
@@ -476,111 +530,68 @@ impl GasSolver {
                 Convection::Hybrid => flux_into.max(diff + 0.5 * flux_into).max(0.0),
             }
         };
-        for (row, &f) in self.face_of[c].iter().enumerate() {
-            let idx = face_index(grid, c, f);
-            let i_c = idx[c];
-            let cell_hi = idx;
-            let cell_lo = step_cell(grid, idx, c, -1).expect("solved faces have a cell on each side");
-            let (eps_lo, eps_hi) = (eps[grid.cell(cell_lo)], eps[grid.cell(cell_hi)]);
+        let area_c = grid.face_area_m2(c);
+        for (row, r) in rows.iter().enumerate() {
+            let f = r.face;
+            let (eps_lo, eps_hi) = (eps[r.cell_lo], eps[r.cell_hi]);
             let eps_f = 0.5 * (eps_lo + eps_hi);
             let mut ap = 0.0;
             let mut b = 0.0;
             let mut net_out = 0.0;
             let mut slot = 0;
-            let mut add =
-                |sys: &mut StencilSystem, neighbour: Result<usize, f64>, a_nb: f64, ap: &mut f64, b: &mut f64| {
-                    *ap += a_nb;
-                    match neighbour {
-                        Ok(face) => {
-                            let q = self.unknown[c][face];
-                            if q == NONE {
-                                *b += a_nb * u[c][face];
-                            } else {
-                                sys.nb[row][slot] = q;
-                                sys.anb[row][slot] = a_nb;
-                                slot += 1;
-                            }
+            let mut add = |sys: &mut StencilSystem, neighbour: Result<NeighbourFace, f64>, a_nb: f64| {
+                ap += a_nb;
+                match neighbour {
+                    Ok(nb) => {
+                        if nb.unknown == NONE {
+                            b += a_nb * u[c][nb.face];
+                        } else {
+                            sys.nb[row][slot] = nb.unknown;
+                            sys.anb[row][slot] = a_nb;
+                            slot += 1;
                         }
-                        Err(value) => *b += a_nb * value,
                     }
-                };
-            // Along c: the control volume's faces are the centres of cell_lo and cell_hi.
-            let area_c = grid.face_area_m2(c);
-            let face_at = |along: isize| -> usize {
-                let n = grid.n[c] as isize;
-                let mut j = idx;
-                j[c] = if grid.periodic(c) {
-                    along.rem_euclid(n) as usize
-                } else {
-                    along as usize
-                };
-                grid.face(c, j)
+                    Err(value) => b += a_nb * value,
+                }
             };
-            let f_east = face_at(i_c as isize + 1);
-            let f_west = face_at(i_c as isize - 1);
-            let flux_e = rho * eps_hi * 0.5 * (u[c][f] + u[c][f_east]) * area_c;
-            let flux_w = rho * eps_lo * 0.5 * (u[c][f_west] + u[c][f]) * area_c;
+            // Along c: the control volume's faces are the centres of cell_lo and cell_hi.
+            let flux_e = rho * eps_hi * 0.5 * (u[c][f] + u[c][r.east.face]) * area_c;
+            let flux_w = rho * eps_lo * 0.5 * (u[c][r.west.face] + u[c][f]) * area_c;
             let diff_e = mu * eps_hi * area_c / grid.h_m[c];
             let diff_w = mu * eps_lo * area_c / grid.h_m[c];
-            add(&mut sys, Ok(f_east), coefficient(-flux_e, diff_e), &mut ap, &mut b);
-            add(&mut sys, Ok(f_west), coefficient(flux_w, diff_w), &mut ap, &mut b);
+            add(&mut sys, Ok(r.east), coefficient(-flux_e, diff_e));
+            add(&mut sys, Ok(r.west), coefficient(flux_w, diff_w));
             net_out += flux_e - flux_w;
-            // Across c: faces between this row of c-faces and the next along d.
-            for dax in (0..grid.axes()).filter(|&x| x != c) {
+            // Across c: faces between this row of c-faces and the next along each other axis.
+            for side in &r.cross {
+                let dax = side.axis;
                 let area_d = grid.face_area_m2(dax);
-                for high in [false, true] {
-                    let delta = if high { 1 } else { -1 };
-                    // The d-face between cell_lo/cell_hi and their neighbours along d.
-                    let d_face_index = |cell: [usize; 3]| -> usize {
-                        let mut j = cell;
-                        j[dax] = cell[dax] + usize::from(high);
-                        grid.face(dax, j)
-                    };
-                    let v_flux = 0.5 * (u[dax][d_face_index(cell_lo)] + u[dax][d_face_index(cell_hi)]);
-                    let neighbour_hi = step_cell(grid, cell_hi, dax, delta);
-                    let neighbour_lo = step_cell(grid, cell_lo, dax, delta);
-                    let sign = if high { 1.0 } else { -1.0 };
-                    let open = |c: Option<[usize; 3]>| c.filter(|c| !cell_blocked(grid, &cfg.blocked, *c));
-                    match (open(neighbour_lo), open(neighbour_hi)) {
-                        (Some(nl), Some(nh)) => {
-                            let eps_corner = 0.25 * (eps_lo + eps_hi + eps[grid.cell(nl)] + eps[grid.cell(nh)]);
-                            let flux = rho * eps_corner * v_flux * area_d;
-                            let diff = mu * eps_corner * area_d / grid.h_m[dax];
-                            let mut j = idx;
-                            j[dax] = nh[dax];
-                            add(
-                                &mut sys,
-                                Ok(grid.face(c, j)),
-                                coefficient(-sign * flux, diff),
-                                &mut ap,
-                                &mut b,
-                            );
-                            net_out += sign * flux;
-                        }
-                        _ => {
-                            // A wall or inlet along d (or blocked cells: a wall at rest or turning with
-                            // `blocked_wall_motion`): the ghost value is the wall's tangential velocity, half a cell
-                            // away.
-                            let boundary = if neighbour_lo.is_some() && neighbour_hi.is_some() {
-                                let mut wall = grid.face_centre_m(c, idx);
-                                wall[dax] += sign * 0.5 * grid.h_m[dax];
-                                Boundary::Wall {
-                                    velocity_m_per_s: cfg.blocked_wall_motion.map_or([0.0; 3], |m| m.velocity_at(wall)),
-                                }
-                            } else {
-                                grid.boundary[side(dax, high)]
-                            };
-                            let flux = rho * eps_f * v_flux * area_d;
-                            let diff = mu * eps_f * area_d / (0.5 * grid.h_m[dax]);
-                            add(
-                                &mut sys,
-                                Err(side_velocity(boundary, self.inflow_factor)[c]),
-                                coefficient(-sign * flux, diff),
-                                &mut ap,
-                                &mut b,
-                            );
-                            net_out += sign * flux;
-                        }
+                let v_flux = 0.5 * (u[dax][side.flux_face_lo] + u[dax][side.flux_face_hi]);
+                let sign = if side.high { 1.0 } else { -1.0 };
+                match side.across {
+                    Across::Open {
+                        beyond_lo,
+                        beyond_hi,
+                        neighbour,
+                    } => {
+                        let eps_corner = 0.25 * (eps_lo + eps_hi + eps[beyond_lo] + eps[beyond_hi]);
+                        let flux = rho * eps_corner * v_flux * area_d;
+                        let diff = mu * eps_corner * area_d / grid.h_m[dax];
+                        add(&mut sys, Ok(neighbour), coefficient(-sign * flux, diff));
+                        net_out += sign * flux;
+                    }
+                    Across::Ghost(boundary) => {
+                        // A wall or inlet along d (or blocked cells: a wall at rest or turning with
+                        // `blocked_wall_motion`): the ghost value is the wall's tangential velocity, half a cell
+                        // away.
+                        let flux = rho * eps_f * v_flux * area_d;
+                        let diff = mu * eps_f * area_d / (0.5 * grid.h_m[dax]);
+                        add(
+                            &mut sys,
+                            Err(side_velocity(boundary, self.inflow_factor)[c]),
+                            coefficient(-sign * flux, diff),
+                        );
+                        net_out += sign * flux;
                     }
                 }
             }
@@ -588,7 +599,7 @@ impl GasSolver {
             // The implicit part of the drag: −β u per unit volume (its +β v part is in `source`).
             ap += a_p0 + net_out + sink.get(f).copied().unwrap_or(0.0) * volume;
             b += a_p0 * old[f];
-            b += eps_f * (p[grid.cell(cell_lo)] - p[grid.cell(cell_hi)]) * area_c;
+            b += eps_f * (p[r.cell_lo] - p[r.cell_hi]) * area_c;
             b += (rho * eps_f * cfg.gravity_m_per_s2[c]) * volume + source.get(f).copied().unwrap_or(0.0) * volume;
             // Under-relaxation (Patankar's implicit form).
             let alpha = cfg.relax_velocity;
@@ -603,52 +614,44 @@ impl GasSolver {
     }
 
     /// Net mass outflow of each cell (kg/s) plus the accumulation term: the pressure-correction right-hand side
-    /// with its sign flipped.
-    fn assemble_pressure_correction(&self, dt_s: f64, old_porosity: &[f64]) -> (StencilSystem, f64) {
+    /// with its sign flipped. `face_porosity` is [`GasSolver::face_porosities`] of the current porosity.
+    fn assemble_pressure_correction(
+        &self,
+        dt_s: f64,
+        old_porosity: &[f64],
+        face_porosity: &[Vec<f64>; 3],
+    ) -> (StencilSystem, f64) {
         let grid = &self.config.grid;
         let rho = self.config.density_kg_per_m3;
         let u = &self.state.velocity_m_per_s;
         let eps = &self.state.porosity;
+        let blocked = &self.config.blocked;
         let mut sys = StencilSystem::new(grid.cells());
         let mut imbalance = 0.0;
         let mut throughput = 0.0;
-        for idx in all_indices(grid.n) {
-            let pcell = grid.cell(idx);
+        let sides_per_cell = 2 * grid.axes();
+        for (pcell, sides) in self.pressure_sides.chunks_exact(sides_per_cell).enumerate() {
             let mut net_out = 0.0;
             let mut slot = 0;
-            for a in 0..grid.axes() {
+            for (k, side) in sides.iter().enumerate() {
+                let (a, high) = (k / 2, k % 2 == 1);
                 let area = grid.face_area_m2(a);
-                for high in [false, true] {
-                    let mut fi = idx;
-                    fi[a] += usize::from(high);
-                    let face = grid.face(a, fi);
-                    let eps_f = self.porosity_at_face(a, fi);
-                    let flux = rho * eps_f * u[a][face] * area;
-                    net_out += if high { flux } else { -flux };
-                    throughput += 0.5 * flux.abs();
-                    // The solved copy of this face (the first face stands for the last on a periodic axis).
-                    let solved_face = if grid.periodic(a) && fi[a] == grid.n[a] {
-                        let mut first = fi;
-                        first[a] = 0;
-                        grid.face(a, first)
-                    } else {
-                        face
-                    };
-                    if self.unknown[a][solved_face] != NONE
-                        && let Some(nb) = step_cell(grid, idx, a, if high { 1 } else { -1 })
-                    {
-                        let coeff = rho * eps_f * area * self.d[a][solved_face];
-                        sys.ap[pcell] += coeff;
-                        // The reference cell's p' is 0: a Dirichlet neighbour, kept out of the (symmetric) stencil.
-                        if self.config.pressure_reference_cell != Some(grid.cell(nb)) {
-                            sys.nb[pcell][slot] = grid.cell(nb) as u32;
-                            sys.anb[pcell][slot] = coeff;
-                            slot += 1;
-                        }
+                let eps_f = face_porosity[a][side.face];
+                let flux = rho * eps_f * u[a][side.face] * area;
+                net_out += if high { flux } else { -flux };
+                throughput += 0.5 * flux.abs();
+                if let Some((solved_face, nb)) = side.solved {
+                    let coeff = rho * eps_f * area * self.d[a][solved_face];
+                    sys.ap[pcell] += coeff;
+                    // The reference cell's p' is 0: a Dirichlet neighbour, kept out of the (symmetric) stencil.
+                    if self.config.pressure_reference_cell != Some(nb) {
+                        sys.nb[pcell][slot] = nb as u32;
+                        sys.anb[pcell][slot] = coeff;
+                        slot += 1;
                     }
                 }
             }
-            if cell_blocked(grid, &self.config.blocked, idx) || self.config.pressure_reference_cell == Some(pcell) {
+            if (!blocked.is_empty() && blocked[pcell]) || self.config.pressure_reference_cell == Some(pcell) {
                 // Outside the gas, or the reference cell: p' = 0.
                 sys.ap[pcell] = 1.0;
                 sys.nb[pcell] = [NONE; NEIGHBOURS];
@@ -661,6 +664,21 @@ impl GasSolver {
             imbalance += (net_out + accumulation).abs();
         }
         (sys, imbalance / throughput.max(f64::MIN_POSITIVE))
+    }
+
+    /// The porosity of every face of each component ([`GasSolver::porosity_at_face`]), for a step's iterations
+    /// (the porosity does not change during a step).
+    fn face_porosities(&self) -> [Vec<f64>; 3] {
+        let grid = &self.config.grid;
+        std::array::from_fn(|a| {
+            if a < grid.axes() {
+                all_indices(grid.face_dims(a))
+                    .map(|idx| self.porosity_at_face(a, idx))
+                    .collect()
+            } else {
+                Vec::new()
+            }
+        })
     }
 
     /// Advances the gas by `dt_s` with momentum source `source[a][face]` (N/m³) and implicit sink coefficient
@@ -698,6 +716,7 @@ impl GasSolver {
             },
             linear_solve_s: 0.0,
         };
+        let face_porosity = self.face_porosities();
         for outer in 0..self.config.max_outer_iterations {
             let before = self.state.velocity_m_per_s.clone();
             for c in 0..axes {
@@ -723,7 +742,7 @@ impl GasSolver {
             }
             self.apply_boundary_velocities();
             self.balance_outlets(dt_s, old_porosity);
-            let (psys, imbalance) = self.assemble_pressure_correction(dt_s, old_porosity);
+            let (psys, imbalance) = self.assemble_pressure_correction(dt_s, old_porosity, &face_porosity);
             report.outer_iterations = outer + 1;
             report.mass_imbalance = imbalance;
             let (mut change, mut scale) = (0.0f64, 0.0f64);
@@ -758,15 +777,13 @@ impl GasSolver {
             report.pressure.iterations += r.iterations;
             report.pressure.relative_residual = report.pressure.relative_residual.max(r.relative_residual);
             report.pressure.converged &= r.converged;
-            let grid = &self.config.grid;
             for (pv, corr) in self.state.pressure_pa.iter_mut().zip(&pc) {
                 *pv += self.config.relax_pressure * corr;
             }
             for c in 0..axes {
-                for &f in &self.face_of[c] {
-                    let idx = face_index(grid, c, f);
-                    let lo = step_cell(grid, idx, c, -1).expect("solved faces have two cells");
-                    self.state.velocity_m_per_s[c][f] += self.d[c][f] * (pc[grid.cell(lo)] - pc[grid.cell(idx)]);
+                for r in &self.rows[c] {
+                    let f = r.face;
+                    self.state.velocity_m_per_s[c][f] += self.d[c][f] * (pc[r.cell_lo] - pc[r.cell_hi]);
                 }
             }
             self.apply_boundary_velocities();
@@ -844,7 +861,7 @@ impl GasSolver {
 }
 
 /// Whether cell `c` is blocked.
-fn cell_blocked(grid: &Grid, blocked: &[bool], c: [usize; 3]) -> bool {
+pub(crate) fn cell_blocked(grid: &Grid, blocked: &[bool], c: [usize; 3]) -> bool {
     !blocked.is_empty() && blocked[grid.cell(c)]
 }
 
