@@ -57,7 +57,8 @@ pub fn half_kick_one(
 }
 
 /// First half of a step: half kick and drift (wrapped on periodic axes). Returns the largest squared displacement
-/// from `reference` (the positions at the last neighbour-list build; empty = skip). With a `team` of several
+/// of a particle in this drift (the simulation sums their roots into a bound on how far any particle has moved since
+/// the neighbour list was built). With a `team` of several
 /// threads, chunks run on it; with one, on the calling thread (per-particle arithmetic, so the same bits).
 ///
 /// No checks here: velocities were checked finite by the kick that made them (`pair_pass.rs`), so positions stay
@@ -71,38 +72,30 @@ pub fn kick_drift(
     dt_s: f64,
     pseudo_2d: bool,
     domain: &Domain,
-    reference: &[Vec3],
     team: &Team,
 ) -> f64 {
     let half_dt = 0.5 * dt_s;
     let g_half_dt = gravity * half_dt;
-    let check_displacement = reference.len() == p.len();
     let chunk =
-        |c: usize, x: &mut [Vec3], v: &mut [Vec3], w: &mut [Vec3], f: &[Vec3], t: &[Vec3], inv: (&[f64], &[f64])| {
+        |_c: usize, x: &mut [Vec3], v: &mut [Vec3], w: &mut [Vec3], f: &[Vec3], t: &[Vec3], inv: (&[f64], &[f64])| {
             let mut max_d2 = 0.0f64;
-            let reference = if check_displacement {
-                &reference[c * CHUNK..c * CHUNK + x.len()]
-            } else {
-                &[]
-            };
             let particles = x
                 .iter_mut()
                 .zip(v.iter_mut())
                 .zip(w.iter_mut())
                 .zip(f.iter().zip(t))
                 .zip(inv.0.iter().zip(inv.1));
-            for (k, ((((x, v), w), (f, t)), (&inv_m, &inv_i))) in particles.enumerate() {
+            for ((((x, v), w), (f, t)), (&inv_m, &inv_i)) in particles {
                 half_kick_one(v, w, f, t, inv_m, inv_i, &g_half_dt, half_dt);
                 if pseudo_2d {
                     v.z = 0.0;
                     w.x = 0.0;
                     w.y = 0.0;
                 }
-                *x += *v * dt_s;
+                let dx = *v * dt_s;
+                *x += dx;
                 domain.wrap(x);
-                if let Some(x0) = reference.get(k) {
-                    max_d2 = max_d2.max(domain.separation(x, x0).norm_squared());
-                }
+                max_d2 = max_d2.max(dx.norm_squared());
             }
             max_d2
         };

@@ -275,8 +275,6 @@ struct Context<'a> {
     wall_angle: &'a [f64],
     dt_s: f64,
     kick: Option<HalfKick>,
-    /// Positions at the last neighbour-list build, for the fused drift's displacement check (empty = none).
-    reference: &'a [Vec3],
     /// The force and torque arrays are all zero on entry (the previous pass fused the next drift).
     accumulators_zeroed: bool,
     /// The cohesion model, in a run that has one.
@@ -330,7 +328,6 @@ impl<'a> Context<'a> {
         wall_angle: &'a [f64],
         dt_s: f64,
         kick: Option<HalfKick>,
-        reference: &'a [Vec3],
         accumulators_zeroed: bool,
         cohesion: Option<&'a Cohesion>,
         bridges: &'a BridgeCache,
@@ -349,7 +346,6 @@ impl<'a> Context<'a> {
             wall_angle,
             dt_s,
             kick,
-            reference,
             accumulators_zeroed,
             cohesion,
             bridges,
@@ -856,8 +852,9 @@ impl<'a> Context<'a> {
     }
 
     /// Finishes particle i once its force and torque are complete: pseudo-2-D projection, the half kick, and when
-    /// fusing, the next step's half kick and drift. Returns (x, v, ω) to store and the squared displacement from
-    /// the neighbour-list reference position (0 when not drifting).
+    /// fusing, the next step's half kick and drift. Returns (x, v, ω) to store and the square of that drift's
+    /// displacement (0 when not drifting), from which the simulation bounds how far any particle has moved since the
+    /// neighbour list was built.
     #[inline(always)]
     fn finish(&self, i: usize, f: &mut Vec3, t: &mut Vec3, x: Vec3, v: Vec3, w: Vec3) -> (Vec3, Vec3, Vec3, f64) {
         if self.config.pseudo_2d {
@@ -888,13 +885,10 @@ impl<'a> Context<'a> {
             w.x = 0.0;
             w.y = 0.0;
         }
-        x += v * k.dt_s;
+        let dx = v * k.dt_s;
+        x += dx;
         self.config.domain.wrap(&mut x);
-        let d2 = self
-            .reference
-            .get(i)
-            .map_or(0.0, |x0| self.config.domain.separation(&x, x0).norm_squared());
-        (x, v, w, d2)
+        (x, v, w, dx.norm_squared())
     }
 }
 
@@ -963,7 +957,7 @@ pub struct ForcePass {
     pub worst_overlap: WorstOverlap,
     /// First particle whose kicked velocity or angular velocity is not finite.
     pub non_finite: Option<usize>,
-    /// With a fused drift: the largest squared displacement from the neighbour-list reference positions.
+    /// With a fused drift: the largest squared displacement of a particle in that drift (0 without one).
     pub max_displacement2_m2: f64,
     /// Square-well crossings in this pass.
     pub well_crossings: u64,
@@ -1006,11 +1000,6 @@ pub fn compute_pair_forces(
     let mut temperature = std::mem::take(&mut p.temperature_k);
     let mut channels = std::mem::take(&mut p.channels);
     let channels_on = channels.is_on();
-    let reference = if list.reference_positions().len() == position.len() {
-        list.reference_positions()
-    } else {
-        &[]
-    };
     let ctx = Context::new(
         config,
         p,
@@ -1018,7 +1007,6 @@ pub fn compute_pair_forces(
         wall_angle,
         dt_s,
         kick,
-        reference,
         accumulators_zeroed,
         cohesion,
         bridges,
@@ -1117,7 +1105,6 @@ pub fn add_wall_forces(
         wall_angle,
         dt_s,
         None,
-        &[],
         false,
         cohesion,
         bridges,
@@ -1626,7 +1613,6 @@ fn range_sweep<P: PassKind>(
         species: &species[lo..hi],
         inv_mass_per_kg: &outer.inv_mass_per_kg[lo..hi],
         inv_inertia_per_kg_m2: &outer.inv_inertia_per_kg_m2[lo..hi],
-        reference: outer.reference.get(lo..hi).unwrap_or(&[]),
         inv_thermal_mass_per_j_k: outer.inv_thermal_mass_per_j_k.get(lo..hi).unwrap_or(&[]),
         ..*outer
     };
