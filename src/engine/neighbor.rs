@@ -184,11 +184,6 @@ impl NeighborList {
         self.wall_start[i] as usize..self.wall_start[i + 1] as usize
     }
 
-    /// Positions at the last build (empty before the first), for the integrator's displacement check.
-    pub fn reference_positions(&self) -> &[Vec3] {
-        &self.reference_position
-    }
-
     /// True when the list may miss a contact: some particle moved more than skin/2 since the build
     /// (`max_displacement2_m2` is the largest squared displacement; two particles closing on each other use up the
     /// skin), a moving wall's surface moved more than skin/2, or the particle count changed.

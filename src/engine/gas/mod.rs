@@ -12,6 +12,7 @@ pub mod grid;
 pub mod heat;
 pub mod linsolve;
 pub(crate) mod momentum_rows;
+pub(crate) mod pressure_sides;
 pub mod scalar;
 pub mod simple;
 pub mod transported_scalar;

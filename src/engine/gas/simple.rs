@@ -21,6 +21,7 @@ use super::linsolve::{
     direct_symmetric,
 };
 use super::momentum_rows::{Across, MomentumRow, NeighbourFace, momentum_rows};
+use super::pressure_sides::{PressureSide, pressure_sides};
 
 /// The convection scheme.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, schemars::JsonSchema)]
@@ -209,7 +210,7 @@ pub(crate) fn step_cell(grid: &Grid, mut i: [usize; 3], axis: usize, delta: isiz
     }
 }
 
-fn all_indices(dims: [usize; 3]) -> impl Iterator<Item = [usize; 3]> {
+pub(crate) fn all_indices(dims: [usize; 3]) -> impl Iterator<Item = [usize; 3]> {
     (0..dims[2]).flat_map(move |k| (0..dims[1]).flat_map(move |j| (0..dims[0]).map(move |i| [i, j, k])))
 }
 
@@ -240,43 +241,6 @@ pub struct GasSolver {
     rows: [Vec<MomentumRow>; 3],
     /// Per cell (in cell order), its faces along each axis, low side first: see [`PressureSide`].
     pressure_sides: Vec<PressureSide>,
-}
-
-/// One face of a cell in the pressure-correction equation: the face (of the component along its axis) and, where
-/// the face's velocity is solved and a cell lies beyond it, the solved copy of the face (the first face stands for
-/// the last on a periodic axis) and that cell.
-#[derive(Debug, Clone, Copy)]
-struct PressureSide {
-    face: usize,
-    solved: Option<(usize, usize)>,
-}
-
-/// The faces of every cell for [`PressureSide`], computed once.
-fn pressure_sides(grid: &Grid, unknown: &[Vec<u32>; 3]) -> Vec<PressureSide> {
-    let mut sides = Vec::with_capacity(grid.cells() * 2 * grid.axes());
-    for idx in all_indices(grid.n) {
-        for a in 0..grid.axes() {
-            for high in [false, true] {
-                let mut fi = idx;
-                fi[a] += usize::from(high);
-                let face = grid.face(a, fi);
-                let solved_face = if grid.periodic(a) && fi[a] == grid.n[a] {
-                    let mut first = fi;
-                    first[a] = 0;
-                    grid.face(a, first)
-                } else {
-                    face
-                };
-                let solved = if unknown[a][solved_face] != NONE {
-                    step_cell(grid, idx, a, if high { 1 } else { -1 }).map(|nb| (solved_face, grid.cell(nb)))
-                } else {
-                    None
-                };
-                sides.push(PressureSide { face, solved });
-            }
-        }
-    }
-    sides
 }
 
 impl GasSolver {
