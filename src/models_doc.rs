@@ -104,8 +104,8 @@ heat (optional: particle temperatures and conduction, seed 000 chapter 5):
 gas (optional: a gas coupled to the particles, fluidized beds):
      { vacuum?, density_kg_per_m3, viscosity_pa_s, cells: [nx, ny, nz], dem_steps_per_gas_step, sides?, jets?, blocked?,
        outside_drum?,
-       drag?, drag_velocities?, drag_coupling?, porosity?, min_porosity?, convection?, solver?, inflow_ramp?,
-       inflow_levels?, pressure_probe_height_m? }
+       drag?, drag_velocities?, drag_coupling?, drag_update?, porosity?, min_porosity?, convection?, solver?,
+       inflow_ramp?, inflow_levels?, pressure_probe_height_m? }
   sides: { x_low?, x_high?, y_low?, y_high?, z_low?, z_high? }, each one of:
     wall                                                                 no-slip (default where not periodic)
     periodic                                                             exactly where domain.periodic is
@@ -122,6 +122,7 @@ gas (optional: a gas coupled to the particles, fluidized beds):
     syamlal_o_brien                                                      seed 001 eqs. 6.4-6.9
   drag_velocities: instantaneous (default) | cell_averaged               seed 002 §3.3 methods 2 and 1
   drag_coupling: explicit (default) | semi_implicit                      the gas's share of the drag
+  drag_update: every_dem_step (default) | every_gas_step                 K, u(x_p), ∇p held over a gas step (CFDEM)
   porosity: volume_split (default) | centre_binning                      particle volume into cells
   convection: upwind (default) | hybrid
   solver: { relax_velocity, relax_pressure, max_outer_iterations, mass_tolerance, velocity_tolerance,
@@ -217,6 +218,7 @@ mod tests {
             serde_json::to_value(schemars::schema_for!(DragLaw)).unwrap(),
             serde_json::to_value(schemars::schema_for!(DragVelocities)).unwrap(),
             serde_json::to_value(schemars::schema_for!(DragCoupling)).unwrap(),
+            serde_json::to_value(schemars::schema_for!(crate::engine::gas::held_drag::DragUpdate)).unwrap(),
             serde_json::to_value(schemars::schema_for!(PorosityMethod)).unwrap(),
             serde_json::to_value(schemars::schema_for!(Convection)).unwrap(),
             serde_json::to_value(schemars::schema_for!(PressureSolver)).unwrap(),

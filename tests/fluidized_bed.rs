@@ -100,6 +100,18 @@ fn a_semi_implicit_bed_restarts_bit_identically_with_its_gas() {
     restart_is_exact("  drag_coupling: semi_implicit\n  drag_velocities: cell_averaged");
 }
 
+/// Drag held over the gas step: the checkpoint 5 DEM steps into a gas step holds each particle's position and
+/// velocity at the evaluation and its velocity sum, and the held values are evaluated again from them.
+#[test]
+fn a_bed_with_drag_held_over_the_gas_step_restarts_bit_identically() {
+    restart_is_exact("  drag_update: every_gas_step");
+}
+
+#[test]
+fn a_semi_implicit_bed_with_held_drag_restarts_bit_identically() {
+    restart_is_exact("  drag_update: every_gas_step\n  drag_coupling: semi_implicit");
+}
+
 #[test]
 fn a_bed_under_an_inflow_ramp_restarts_bit_identically() {
     // The stop at step 1503 (t = 15 ms) falls inside the ramp (5-25 ms).
@@ -152,6 +164,11 @@ fn restart_is_exact(extra: &str) {
     assert_eq!(
         gas.reaction_steps, 5,
         "the restart must carry a partly accumulated reaction"
+    );
+    assert_eq!(
+        gas.held_drag.is_some(),
+        extra.contains("every_gas_step"),
+        "held drag in the checkpoint exactly when the scenario holds it"
     );
     let log = run_ok(&["simulate", "bed.yaml", "--out", "split", "--threads", "1"], dir);
     assert!(log.contains("resuming from"), "{log}");

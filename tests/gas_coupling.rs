@@ -269,3 +269,92 @@ fn fluid_forces_on_a_team_give_the_same_bits_as_on_one_thread() {
         }
     }
 }
+
+/// Drag held over a gas step (`gas.drag_update: every_gas_step`): the first sub-step's forces are the every-step
+/// scheme's to the bit; later sub-steps keep K, u and the pressure force of that moment with the particle's new
+/// velocity and position; the gas then gets, once, exactly what the particles got over the sub-steps.
+#[test]
+fn held_drag_keeps_the_first_sub_steps_values_and_gives_the_gas_what_the_particles_got() {
+    use granflow::engine::gas::held_drag::DragUpdate;
+    let sim = settling(1);
+    let mut every = sim.gas.as_ref().unwrap().fluid.clone();
+    for a in 0..3 {
+        for (f, v) in every.velocity_m_per_s[a].iter_mut().enumerate() {
+            *v = 0.013 * (f % 5) as f64 - 0.01 * a as f64;
+        }
+        for (f, g) in every.minus_pressure_gradient_pa_per_m[a].iter_mut().enumerate() {
+            *g = 3.0 * (f % 3) as f64;
+        }
+    }
+    let mut held = every.clone();
+    held.drag_update = DragUpdate::EveryGasStep;
+    let n = 40;
+    let mut positions: Vec<Vec3> = (0..n)
+        .map(|k| {
+            let t = k as f64;
+            Vec3::new((t * 0.000_37) % 0.009, (t * 0.000_53) % 0.009, (t * 0.000_71) % 0.03)
+        })
+        .collect();
+    let mut velocities: Vec<Vec3> = (0..n)
+        .map(|k| Vec3::new(0.001 * (k % 7) as f64, -0.02, 0.003))
+        .collect();
+    let radii = vec![RADIUS; n];
+    let (mut f_every, mut f_held) = (vec![Vec3::zeros(); n], vec![Vec3::zeros(); n]);
+    every.add_forces(&positions, &velocities, &radii, &mut f_every, None);
+    held.add_forces(&positions, &velocities, &radii, &mut f_held, None);
+    assert!(f_every.iter().zip(&f_held).all(|(a, b)| a == b), "first sub-step differs");
+    let first = f_held.clone();
+    // Three more sub-steps: the particles move across cells and change velocity by dv.
+    let mut received = f_held.iter().sum::<Vec3>();
+    let dv = Vec3::new(0.01, -0.003, 0.02);
+    for _ in 0..3 {
+        for (x, v) in positions.iter_mut().zip(velocities.iter_mut()) {
+            *x += Vec3::new(0.0011, 0.0007, -0.0013);
+            *v += dv;
+        }
+        let mut f = vec![Vec3::zeros(); n];
+        held.add_forces(&positions, &velocities, &radii, &mut f, None);
+        received += f.iter().sum::<Vec3>();
+        f_held = f;
+    }
+    // Held K: the force changed by −K dv per sub-step only (position no longer matters).
+    for i in 0..n {
+        let k = -(f_held[i] - first[i]).x / (3.0 * dv.x);
+        let expected = first[i] - dv * (3.0 * k);
+        assert!((f_held[i] - expected).norm() <= 1e-12 * first[i].norm().max(1e-12), "particle {i}");
+        assert!(k > 0.0, "particle {i}: K = {k}");
+    }
+    // The pressure force is not returned to the gas: what the gas gets is minus the drag alone.
+    let pressure: Vec3 = (0..n)
+        .map(|i| {
+            let volume = 4.0 / 3.0 * std::f64::consts::PI * RADIUS.powi(3);
+            let mut g = Vec3::zeros();
+            for a in 0..3 {
+                g[a] = granflow::engine::gas::coupling::interpolate_component(
+                    &held.grid,
+                    &held.minus_pressure_gradient_pa_per_m[a],
+                    a,
+                    &(positions[i] - Vec3::new(0.0011, 0.0007, -0.0013) * 3.0),
+                );
+            }
+            g * volume
+        })
+        .sum();
+    let drag_received = received - pressure * 4.0;
+    assert!(held.momentum_exchange[0].transfer_sum.iter().all(|v| *v == 0.0), "spread only at the gas step");
+    held.settle_held_reaction();
+    let volume = held.grid.cell_volume_m3();
+    for a in 0..3 {
+        let given: f64 = held.momentum_exchange[a].transfer_sum.iter().sum::<f64>() * volume;
+        assert!(
+            (given + drag_received[a]).abs() <= 1e-10 * drag_received.norm(),
+            "axis {a}: gas got {given}, particles {}",
+            drag_received[a]
+        );
+    }
+    assert_eq!(held.steps(), 4);
+    // Settling twice adds nothing.
+    let once = held.momentum_exchange.clone();
+    held.settle_held_reaction();
+    assert_eq!(once, held.momentum_exchange);
+}

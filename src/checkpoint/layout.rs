@@ -25,6 +25,7 @@ use crate::engine::channels::{CHANNELS, ChannelInfo, ParticleChannels};
 use crate::engine::contacts::{ContactStore, WallId};
 use crate::engine::gas::ExchangeAccumulator;
 use crate::engine::gas::coupled::{GasScalarSnapshot, GasSnapshot, GasStepStats};
+use crate::engine::gas::held_drag::HeldDragSnapshot;
 use crate::engine::models::ContactHistory;
 use crate::engine::models::history::{FieldKind, FieldValue, HISTORY_FIELDS, HistoryField};
 use crate::engine::net_force::NetForceTally;
@@ -385,6 +386,9 @@ datasets! {
     gas_temperature_k: f64 => "gas/temperature_k", Rows::GasCellsIfHeat, 1, "K";
     gas_heat_transfer_sum: f64 => "gas/heat_transfer_sum_k_kg_per_m3_s", Rows::GasCellsIfHeat, 1, "K kg/(m3 s)";
     gas_heat_exchange_steps: u32 => "gas/heat_exchange_steps", Rows::GasScalarIfHeat, 1, "1";
+    held_drag_position_m: f64 => "gas/held_drag/position_m", Rows::ParticlesIfRecorded, 3, "m";
+    held_drag_velocity: f64 => "gas/held_drag/velocity_m_per_s", Rows::ParticlesIfRecorded, 3, "m/s";
+    held_drag_velocity_sum: f64 => "gas/held_drag/velocity_sum_m_per_s", Rows::ParticlesIfRecorded, 3, "m/s";
 
     liquid_m3: f64 => "particles/liquid_m3", Rows::Particles, 1, "m3";
     sprayed_m3: f64 => "particles/sprayed_m3", Rows::Particles, 1, "m3";
@@ -406,6 +410,7 @@ pub(crate) const GROUPS: &[&str] = &[
     "rng",
     "gas",
     "gas/last_step",
+    "gas/held_drag",
     "net_force",
     "particles/channels",
 ];
@@ -435,6 +440,7 @@ impl Arrays {
         let gas = state.gas.as_ref();
         // The one transported scalar a checkpoint holds today: the gas temperature of a run with heat transfer.
         let gas_temperature = gas.and_then(|g| g.scalars.iter().find(|s| s.name == GAS_TEMPERATURE));
+        let held = gas.and_then(|g| g.held_drag.as_ref());
         Arrays {
             particle_id: p.id.iter().map(|id| id.0).collect(),
             particle_species: p.species.iter().map(|s| s.0).collect(),
@@ -497,6 +503,9 @@ impl Arrays {
                 .map(|s| s.exchange.transfer_sum.clone())
                 .unwrap_or_default(),
             gas_heat_exchange_steps: gas_temperature.map(|s| s.exchange.steps).into_iter().collect(),
+            held_drag_position_m: held.map(|h| flatten(&h.position_m)).unwrap_or_default(),
+            held_drag_velocity: held.map(|h| flatten(&h.velocity_m_per_s)).unwrap_or_default(),
+            held_drag_velocity_sum: held.map(|h| flatten(&h.velocity_sum_m_per_s)).unwrap_or_default(),
 
             liquid_m3: p.liquid_m3.clone(),
             sprayed_m3: p.sprayed_m3.clone(),
@@ -594,7 +603,12 @@ impl Arrays {
         let optional = CHANNELS
             .iter()
             .map(|info| (info.path, (info.get)(&self.channels).len()))
-            .chain([("particles/temperature_k", self.temperature_k.len())]);
+            .chain([("particles/temperature_k", self.temperature_k.len())])
+            .chain([
+                ("gas/held_drag/position_m", self.held_drag_position_m.len() / 3),
+                ("gas/held_drag/velocity_m_per_s", self.held_drag_velocity.len() / 3),
+                ("gas/held_drag/velocity_sum_m_per_s", self.held_drag_velocity_sum.len() / 3),
+            ]);
         for (path, rows) in optional {
             if rows != 0 && rows != n {
                 return Err(format!("/{path} has {rows} rows, expected 0 or one per particle ({n})"));
@@ -685,6 +699,11 @@ impl Arrays {
                 mass_imbalance: self.gas_last_mass_imbalance[0],
                 converged: self.gas_last_converged[0] == 1,
             },
+            held_drag: (!self.held_drag_position_m.is_empty()).then(|| HeldDragSnapshot {
+                position_m: unflatten(&self.held_drag_position_m),
+                velocity_m_per_s: unflatten(&self.held_drag_velocity),
+                velocity_sum_m_per_s: unflatten(&self.held_drag_velocity_sum),
+            }),
             scalars: (self.gas_temperature_k.len() == cells && cells > 0)
                 .then(|| GasScalarSnapshot {
                     name: GAS_TEMPERATURE.into(),

@@ -31,7 +31,7 @@ use crate::engine::SimState;
 
 /// Version of the file layout. Bump it whenever a name, type, shape or the checksum definition changes; readers
 /// reject any other version with [`CheckpointError::Version`].
-pub const CHECKPOINT_FORMAT_VERSION: u32 = 7;
+pub const CHECKPOINT_FORMAT_VERSION: u32 = 8;
 
 /// Metadata stored beside the state.
 #[derive(Debug, Clone, PartialEq)]
@@ -565,6 +565,11 @@ mod tests {
                     mass_imbalance: 1.25e-9,
                     converged: true,
                 },
+                held_drag: Some(crate::engine::gas::held_drag::HeldDragSnapshot {
+                    position_m: (0..5).map(|k| v(0.01 * k as f64, 0.0625, -1e-300)).collect(),
+                    velocity_m_per_s: (0..5).map(|k| v(-0.5, 0.25 * k as f64, SUBNORMAL)).collect(),
+                    velocity_sum_m_per_s: (0..5).map(|k| v(3.0 * k as f64, -7.5, 1e-9)).collect(),
+                }),
                 scalars: vec![crate::engine::gas::coupled::GasScalarSnapshot {
                     name: "temperature_k".into(),
                     unit: "K".into(),
@@ -678,6 +683,7 @@ mod tests {
         let mut state = sample_state();
         state.particles = Particles::default();
         state.contacts = ContactStore::default();
+        state.gas.as_mut().expect("the sample has a gas").held_drag = None;
         round_trip(&state, &sample_meta());
     }
 
@@ -1132,6 +1138,11 @@ mod tests {
             &[1],
             &heat.exchange.steps.to_le_bytes(),
         );
+        let held = gas.held_drag.as_ref().expect("the sample holds held drag");
+        ds(&mut b, "gas/held_drag/position_m", &[n, 3], &v3(&held.position_m));
+        ds(&mut b, "gas/held_drag/velocity_m_per_s", &[n, 3], &v3(&held.velocity_m_per_s));
+        let sums = v3(&held.velocity_sum_m_per_s);
+        ds(&mut b, "gas/held_drag/velocity_sum_m_per_s", &[n, 3], &sums);
         ds(&mut b, "particles/liquid_m3", &[n], &f(p.liquid_m3.iter().copied()));
         ds(&mut b, "particles/sprayed_m3", &[n], &f(p.sprayed_m3.iter().copied()));
         ds(

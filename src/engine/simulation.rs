@@ -328,7 +328,7 @@ impl Simulation {
     /// Puts a checkpointed gas state into the attached gas.
     pub fn restore_gas(&mut self, snap: &super::gas::coupled::GasSnapshot) -> Result<(), String> {
         match self.gas.as_mut() {
-            Some(g) => g.restore(snap),
+            Some(g) => g.restore(snap, &self.particles.radius_m),
             None => Err("the checkpoint holds a gas but the scenario has none".into()),
         }
     }

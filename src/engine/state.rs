@@ -174,6 +174,19 @@ pub fn first_difference(a: &SimState, b: &SimState) -> Option<String> {
                 })
             })
             .or_else(|| (g.reaction_steps != h.reaction_steps).then(|| "gas.reaction_steps".to_string()))
+            .or_else(|| match (&g.held_drag, &h.held_drag) {
+                (Some(x), Some(y)) => vectors("gas.held_drag.position_m", &x.position_m, &y.position_m)
+                    .or_else(|| vectors("gas.held_drag.velocity_m_per_s", &x.velocity_m_per_s, &y.velocity_m_per_s))
+                    .or_else(|| {
+                        vectors(
+                            "gas.held_drag.velocity_sum_m_per_s",
+                            &x.velocity_sum_m_per_s,
+                            &y.velocity_sum_m_per_s,
+                        )
+                    }),
+                (None, None) => None,
+                _ => Some("gas.held_drag: present in one state only".into()),
+            })
             .or_else(|| {
                 g.scalars.iter().zip(&h.scalars).find_map(|(x, y)| {
                     let (p, q) = (&x.exchange, &y.exchange);

@@ -13,6 +13,7 @@ use crate::engine::gas::GasScalarSpec;
 use crate::engine::gas::coupled::GasCoupling;
 use crate::engine::gas::coupling::PorosityMethod;
 use crate::engine::gas::fluid_forces::{DragCoupling, DragVelocities};
+use crate::engine::gas::held_drag::DragUpdate;
 use crate::engine::gas::grid::side;
 use crate::engine::gas::heat::GasThermal;
 use crate::engine::gas::linsolve::PressureSolver;
@@ -56,6 +57,11 @@ pub struct GasSpec {
     /// 2 ρ_g ε / β) or `semi_implicit` (−β u_new + β v: stable for dense beds and strong jets).
     #[serde(default)]
     pub drag_coupling: DragCoupling,
+    /// When each particle's drag coefficient, the gas velocity and the pressure gradient at it are evaluated:
+    /// `every_dem_step` (default) or `every_gas_step` (held over the gas step, CFDEM's coupling interval: the drag
+    /// law and the interpolation run once per gas step; needs `drag_velocities: instantaneous`).
+    #[serde(default)]
+    pub drag_update: DragUpdate,
     /// How particle volume becomes cell porosity (default `volume_split`).
     #[serde(default)]
     pub porosity: PorosityMethod,
@@ -230,6 +236,7 @@ pub struct GasSetup {
     pub drag: DragLaw,
     pub drag_velocities: DragVelocities,
     pub drag_coupling: DragCoupling,
+    pub drag_update: DragUpdate,
     pub porosity_method: PorosityMethod,
     pub min_porosity: f64,
     pub dem_steps_per_gas_step: u64,
@@ -254,6 +261,7 @@ impl GasSetup {
             radii_m,
         )?;
         coupling.drag_coupling = self.drag_coupling;
+        coupling.fluid.drag_update = self.drag_update;
         if let Some((thermal, spec)) = &self.heat {
             coupling.attach_heat(*thermal, spec.clone())?;
         }
@@ -327,6 +335,12 @@ pub fn build_gas(
     }
     if spec.dem_steps_per_gas_step == 0 {
         return Err(fail("gas.dem_steps_per_gas_step".into(), "expected at least 1".into()));
+    }
+    if spec.drag_update == DragUpdate::EveryGasStep && spec.drag_velocities != DragVelocities::Instantaneous {
+        return Err(fail(
+            "gas.drag_update".into(),
+            "every_gas_step holds each particle's own drag; it needs drag_velocities: instantaneous".into(),
+        ));
     }
     if !(spec.min_porosity.is_finite() && spec.min_porosity > 0.0 && spec.min_porosity < 1.0) {
         return Err(fail(
@@ -584,6 +598,7 @@ pub fn build_gas(
         drag: spec.drag,
         drag_velocities: spec.drag_velocities,
         drag_coupling: spec.drag_coupling,
+        drag_update: spec.drag_update,
         porosity_method: spec.porosity,
         min_porosity: spec.min_porosity,
         dem_steps_per_gas_step: spec.dem_steps_per_gas_step,

@@ -16,6 +16,7 @@ use super::exchange_accumulator::ExchangeAccumulator;
 use super::field::{FieldLocation, GasField, GasFieldView};
 use super::fluid_forces::{DragCoupling, DragVelocities, FluidForces};
 use super::grid::{Boundary, side};
+use super::held_drag::HeldDragSnapshot;
 use super::simple::{GasConfig, GasSolver};
 use super::transported_scalar::{GasScalarSpec, TransportedScalar};
 use crate::engine::Vec3;
@@ -49,6 +50,9 @@ pub struct GasSnapshot {
     pub beta_velocity_sum: [Vec<f64>; 3],
     pub reaction_steps: u32,
     pub last: GasStepStats,
+    /// Under drag held over the gas step, within a gas step: what evaluates the held values again
+    /// (`held_drag.rs`); `None` otherwise.
+    pub held_drag: Option<HeldDragSnapshot>,
     /// The transported scalars in their declaration order; empty when none is declared (the checkpoint then has
     /// nothing more to hold).
     pub scalars: Vec<GasScalarSnapshot>,
@@ -192,6 +196,7 @@ impl GasCoupling {
         let grid = &self.solver.config.grid;
         let new_porosity = porosity(grid, self.porosity_method, positions_m, radii_m, self.min_porosity);
         let old_porosity = std::mem::replace(&mut self.solver.state.porosity, new_porosity);
+        self.fluid.settle_held_reaction();
         let (mut source, sink) = match self.drag_coupling {
             DragCoupling::Explicit => (self.fluid.mean_reaction(), Default::default()),
             DragCoupling::SemiImplicit => {
@@ -296,6 +301,7 @@ impl GasCoupling {
             beta_velocity_sum: std::array::from_fn(|a| self.fluid.momentum_exchange[a].coefficient_value_sum.clone()),
             reaction_steps: self.fluid.steps(),
             last: self.last,
+            held_drag: self.fluid.held_snapshot(),
             scalars: self
                 .scalars
                 .iter()
@@ -310,8 +316,9 @@ impl GasCoupling {
     }
 
     /// Puts a checkpointed gas state back (the grid must match: checked by the checkpoint reader's shapes and
-    /// here against the solver's; the transported scalars must be those declared, by name and in order).
-    pub fn restore(&mut self, snap: &GasSnapshot) -> Result<(), String> {
+    /// here against the solver's; the transported scalars must be those declared, by name and in order). `radii_m`
+    /// are the particles' (held drag is evaluated again from the checkpoint's positions and velocities).
+    pub fn restore(&mut self, snap: &GasSnapshot, radii_m: &[f64]) -> Result<(), String> {
         let grid = &self.solver.config.grid;
         let declared: Vec<&str> = self.scalars.iter().map(|s| s.spec.name).collect();
         let stored: Vec<&str> = snap.scalars.iter().map(|s| s.name.as_str()).collect();
@@ -371,6 +378,22 @@ impl GasCoupling {
                 &snap.reaction_n_per_m3[a],
                 snap.reaction_steps,
             )?;
+        }
+        match (self.fluid.drag_update, &snap.held_drag) {
+            (super::held_drag::DragUpdate::EveryGasStep, Some(held)) => self.fluid.restore_held(held, radii_m)?,
+            (super::held_drag::DragUpdate::EveryGasStep, None) if snap.reaction_steps > 0 => {
+                return Err(format!(
+                    "the checkpoint lies {} DEM steps into a gas step but holds no held drag; the scenario holds \
+                     drag over the gas step (gas.drag_update: every_gas_step): was it written with every_dem_step?",
+                    snap.reaction_steps
+                ));
+            }
+            (super::held_drag::DragUpdate::EveryDemStep, Some(_)) => {
+                return Err("the checkpoint holds drag held over a gas step; the scenario evaluates it every DEM \
+                            step (gas.drag_update: every_dem_step)"
+                    .into());
+            }
+            _ => {}
         }
         self.last = snap.last;
         Ok(())

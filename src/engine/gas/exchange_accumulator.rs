@@ -44,6 +44,14 @@ impl ExchangeAccumulator {
         self.coefficient_value_sum[slot] += coefficient * particle_value;
     }
 
+    /// Adds sums over several sub-steps at once: Σk and Σk·φ_p of one particle's share of `slot` (an exchange
+    /// held over the sub-steps and spread once).
+    #[inline]
+    pub fn add_exchange_sums(&mut self, slot: usize, coefficient_sum: f64, coefficient_value_sum: f64) {
+        self.coefficient_sum[slot] += coefficient_sum;
+        self.coefficient_value_sum[slot] += coefficient_value_sum;
+    }
+
     /// Adds `amount` received by the gas at `slot` (explicit form).
     #[inline]
     pub fn add_transfer(&mut self, slot: usize, amount: f64) {

@@ -10,6 +10,7 @@ pub mod field;
 pub mod fluid_forces;
 pub mod grid;
 pub mod heat;
+pub mod held_drag;
 pub mod linsolve;
 pub(crate) mod momentum_rows;
 pub(crate) mod pressure_sides;
