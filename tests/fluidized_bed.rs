@@ -108,8 +108,8 @@ fn a_bed_with_drag_held_over_the_gas_step_restarts_bit_identically() {
 }
 
 #[test]
-fn a_semi_implicit_bed_with_held_drag_restarts_bit_identically() {
-    restart_is_exact("  drag_update: every_gas_step\n  drag_coupling: semi_implicit");
+fn a_semi_implicit_cell_averaged_bed_with_held_drag_restarts_bit_identically() {
+    restart_is_exact("  drag_update: every_gas_step\n  drag_coupling: semi_implicit\n  drag_velocities: cell_averaged");
 }
 
 #[test]

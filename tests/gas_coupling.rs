@@ -302,7 +302,10 @@ fn held_drag_keeps_the_first_sub_steps_values_and_gives_the_gas_what_the_particl
     let (mut f_every, mut f_held) = (vec![Vec3::zeros(); n], vec![Vec3::zeros(); n]);
     every.add_forces(&positions, &velocities, &radii, &mut f_every, None);
     held.add_forces(&positions, &velocities, &radii, &mut f_held, None);
-    assert!(f_every.iter().zip(&f_held).all(|(a, b)| a == b), "first sub-step differs");
+    assert!(
+        f_every.iter().zip(&f_held).all(|(a, b)| a == b),
+        "first sub-step differs"
+    );
     let first = f_held.clone();
     // Three more sub-steps: the particles move across cells and change velocity by dv.
     let mut received = f_held.iter().sum::<Vec3>();
@@ -321,7 +324,10 @@ fn held_drag_keeps_the_first_sub_steps_values_and_gives_the_gas_what_the_particl
     for i in 0..n {
         let k = -(f_held[i] - first[i]).x / (3.0 * dv.x);
         let expected = first[i] - dv * (3.0 * k);
-        assert!((f_held[i] - expected).norm() <= 1e-12 * first[i].norm().max(1e-12), "particle {i}");
+        assert!(
+            (f_held[i] - expected).norm() <= 1e-12 * first[i].norm().max(1e-12),
+            "particle {i}"
+        );
         assert!(k > 0.0, "particle {i}: K = {k}");
     }
     // The pressure force is not returned to the gas: what the gas gets is minus the drag alone.
@@ -341,7 +347,10 @@ fn held_drag_keeps_the_first_sub_steps_values_and_gives_the_gas_what_the_particl
         })
         .sum();
     let drag_received = received - pressure * 4.0;
-    assert!(held.momentum_exchange[0].transfer_sum.iter().all(|v| *v == 0.0), "spread only at the gas step");
+    assert!(
+        held.momentum_exchange[0].transfer_sum.iter().all(|v| *v == 0.0),
+        "spread only at the gas step"
+    );
     held.settle_held_reaction();
     let volume = held.grid.cell_volume_m3();
     for a in 0..3 {
@@ -357,4 +366,82 @@ fn held_drag_keeps_the_first_sub_steps_values_and_gives_the_gas_what_the_particl
     let once = held.momentum_exchange.clone();
     held.settle_held_reaction();
     assert_eq!(once, held.momentum_exchange);
+}
+
+/// Cell-averaged drag held over a gas step: the first sub-step is the every-step scheme's to the bit; afterwards
+/// each particle keeps its cell of the evaluation and feels K (u_c − v_sm) with that cell's present mean velocity,
+/// and the gas gets once exactly what the particles got.
+#[test]
+fn held_cell_averaged_drag_keeps_the_cells_of_the_evaluation() {
+    use granflow::engine::gas::held_drag::DragUpdate;
+    let sim = settling(1);
+    let mut every = sim.gas.as_ref().unwrap().fluid.clone();
+    every.drag_velocities = DragVelocities::CellAveraged;
+    for a in 0..3 {
+        for (f, v) in every.velocity_m_per_s[a].iter_mut().enumerate() {
+            *v = 0.01 * (f % 7) as f64 - 0.02 * a as f64;
+        }
+        for (f, g) in every.minus_pressure_gradient_pa_per_m[a].iter_mut().enumerate() {
+            *g = 2.0 * (f % 4) as f64;
+        }
+    }
+    let mut held = every.clone();
+    held.drag_update = DragUpdate::EveryGasStep;
+    let mut positions: Vec<Vec3> = (0..9)
+        .map(|k| {
+            Vec3::new(
+                0.0005 + 0.0011 * k as f64,
+                0.004 + 0.0003 * (k % 3) as f64,
+                0.01 + 0.002 * (k % 4) as f64,
+            )
+        })
+        .collect();
+    let mut velocities: Vec<Vec3> = (0..9)
+        .map(|k| Vec3::new(0.1 * k as f64, -0.05, 0.02 * (k % 2) as f64))
+        .collect();
+    let radii: Vec<f64> = (0..9).map(|k| if k == 4 { 1.5 * RADIUS } else { RADIUS }).collect();
+    let (mut f_every, mut f_held) = (vec![Vec3::zeros(); 9], vec![Vec3::zeros(); 9]);
+    every.add_forces(&positions, &velocities, &radii, &mut f_every, None);
+    held.add_forces(&positions, &velocities, &radii, &mut f_held, None);
+    assert!(
+        f_every.iter().zip(&f_held).all(|(a, b)| a == b),
+        "first sub-step differs"
+    );
+    let mut received: Vec3 = f_held.iter().sum();
+    let mut pressure_sum = Vec3::zeros();
+    for i in 0..9 {
+        let mut g = Vec3::zeros();
+        for a in 0..3 {
+            g[a] = granflow::engine::gas::coupling::interpolate_component(
+                &held.grid,
+                &held.minus_pressure_gradient_pa_per_m[a],
+                a,
+                &positions[i],
+            );
+        }
+        pressure_sum += g * (4.0 / 3.0 * std::f64::consts::PI * radii[i].powi(3));
+    }
+    // Two more sub-steps, the particles moved by more than a cell: the held forces do not see the move, only the
+    // velocity change (one particle's change moves its whole cell's mean).
+    for _ in 0..2 {
+        for (x, v) in positions.iter_mut().zip(velocities.iter_mut()) {
+            *x += Vec3::new(0.002, 0.0, 0.0);
+            *v += Vec3::new(0.0, 0.01, 0.0);
+        }
+        let mut f = vec![Vec3::zeros(); 9];
+        held.add_forces(&positions, &velocities, &radii, &mut f, None);
+        received += f.iter().sum::<Vec3>();
+    }
+    held.settle_held_reaction();
+    let drag_received = received - pressure_sum * 3.0;
+    let volume = held.grid.cell_volume_m3();
+    for a in 0..3 {
+        let given: f64 = held.momentum_exchange[a].transfer_sum.iter().sum::<f64>() * volume;
+        assert!(
+            (given + drag_received[a]).abs() <= 1e-10 * drag_received.norm(),
+            "axis {a}: gas got {given}, particles {}",
+            drag_received[a]
+        );
+    }
+    assert_eq!(held.steps(), 3);
 }

@@ -607,7 +607,10 @@ impl Arrays {
             .chain([
                 ("gas/held_drag/position_m", self.held_drag_position_m.len() / 3),
                 ("gas/held_drag/velocity_m_per_s", self.held_drag_velocity.len() / 3),
-                ("gas/held_drag/velocity_sum_m_per_s", self.held_drag_velocity_sum.len() / 3),
+                (
+                    "gas/held_drag/velocity_sum_m_per_s",
+                    self.held_drag_velocity_sum.len() / 3,
+                ),
             ]);
         for (path, rows) in optional {
             if rows != 0 && rows != n {

@@ -1140,7 +1140,12 @@ mod tests {
         );
         let held = gas.held_drag.as_ref().expect("the sample holds held drag");
         ds(&mut b, "gas/held_drag/position_m", &[n, 3], &v3(&held.position_m));
-        ds(&mut b, "gas/held_drag/velocity_m_per_s", &[n, 3], &v3(&held.velocity_m_per_s));
+        ds(
+            &mut b,
+            "gas/held_drag/velocity_m_per_s",
+            &[n, 3],
+            &v3(&held.velocity_m_per_s),
+        );
         let sums = v3(&held.velocity_sum_m_per_s);
         ds(&mut b, "gas/held_drag/velocity_sum_m_per_s", &[n, 3], &sums);
         ds(&mut b, "particles/liquid_m3", &[n], &f(p.liquid_m3.iter().copied()));

@@ -176,7 +176,13 @@ pub fn first_difference(a: &SimState, b: &SimState) -> Option<String> {
             .or_else(|| (g.reaction_steps != h.reaction_steps).then(|| "gas.reaction_steps".to_string()))
             .or_else(|| match (&g.held_drag, &h.held_drag) {
                 (Some(x), Some(y)) => vectors("gas.held_drag.position_m", &x.position_m, &y.position_m)
-                    .or_else(|| vectors("gas.held_drag.velocity_m_per_s", &x.velocity_m_per_s, &y.velocity_m_per_s))
+                    .or_else(|| {
+                        vectors(
+                            "gas.held_drag.velocity_m_per_s",
+                            &x.velocity_m_per_s,
+                            &y.velocity_m_per_s,
+                        )
+                    })
                     .or_else(|| {
                         vectors(
                             "gas.held_drag.velocity_sum_m_per_s",

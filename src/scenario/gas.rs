@@ -13,9 +13,9 @@ use crate::engine::gas::GasScalarSpec;
 use crate::engine::gas::coupled::GasCoupling;
 use crate::engine::gas::coupling::PorosityMethod;
 use crate::engine::gas::fluid_forces::{DragCoupling, DragVelocities};
-use crate::engine::gas::held_drag::DragUpdate;
 use crate::engine::gas::grid::side;
 use crate::engine::gas::heat::GasThermal;
+use crate::engine::gas::held_drag::DragUpdate;
 use crate::engine::gas::linsolve::PressureSolver;
 use crate::engine::gas::simple::{InflowLevels, InflowRamp, InletFace};
 use crate::engine::gas::{Boundary, Convection, GasConfig, Grid};
@@ -59,7 +59,7 @@ pub struct GasSpec {
     pub drag_coupling: DragCoupling,
     /// When each particle's drag coefficient, the gas velocity and the pressure gradient at it are evaluated:
     /// `every_dem_step` (default) or `every_gas_step` (held over the gas step, CFDEM's coupling interval: the drag
-    /// law and the interpolation run once per gas step; needs `drag_velocities: instantaneous`).
+    /// law and the interpolation run once per gas step).
     #[serde(default)]
     pub drag_update: DragUpdate,
     /// How particle volume becomes cell porosity (default `volume_split`).
@@ -335,12 +335,6 @@ pub fn build_gas(
     }
     if spec.dem_steps_per_gas_step == 0 {
         return Err(fail("gas.dem_steps_per_gas_step".into(), "expected at least 1".into()));
-    }
-    if spec.drag_update == DragUpdate::EveryGasStep && spec.drag_velocities != DragVelocities::Instantaneous {
-        return Err(fail(
-            "gas.drag_update".into(),
-            "every_gas_step holds each particle's own drag; it needs drag_velocities: instantaneous".into(),
-        ));
     }
     if !(spec.min_porosity.is_finite() && spec.min_porosity > 0.0 && spec.min_porosity < 1.0) {
         return Err(fail(

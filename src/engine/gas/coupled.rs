@@ -389,9 +389,11 @@ impl GasCoupling {
                 ));
             }
             (super::held_drag::DragUpdate::EveryDemStep, Some(_)) => {
-                return Err("the checkpoint holds drag held over a gas step; the scenario evaluates it every DEM \
+                return Err(
+                    "the checkpoint holds drag held over a gas step; the scenario evaluates it every DEM \
                             step (gas.drag_update: every_dem_step)"
-                    .into());
+                        .into(),
+                );
             }
             _ => {}
         }

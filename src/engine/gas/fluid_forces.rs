@@ -18,7 +18,7 @@ use serde::{Deserialize, Serialize};
 use super::coupling::{FaceLattice, Stencil, floor_to_isize};
 use super::exchange_accumulator::ExchangeAccumulator;
 use super::grid::Grid;
-use super::held_drag::{DragUpdate, HeldDrag, HeldDragSnapshot};
+use super::held_drag::{DragUpdate, HeldDrag};
 use crate::engine::Vec3;
 use crate::engine::models::drag::{DragInput, DragLaw};
 use crate::engine::team::Team;
@@ -57,7 +57,7 @@ type StencilDragRecord = (DragRecord, [Stencil; 3]);
 
 /// Runs `compute` for every particle (index, its drag record, its force), on `team` when given (a few contiguous
 /// blocks of particles per thread). Particles are independent, so the result is the same on any thread count.
-fn per_particle<R, S, F>(team: Option<&Team>, drag: &mut [R], force: &mut [S], compute: F)
+pub(super) fn per_particle<R, S, F>(team: Option<&Team>, drag: &mut [R], force: &mut [S], compute: F)
 where
     R: Send,
     S: Send,
@@ -111,7 +111,7 @@ pub struct FluidForces {
     inverse_h_per_m: [f64; 3],
     periodic: [bool; 3],
     workspace: Workspace,
-    held: HeldDrag,
+    pub(super) held: HeldDrag,
 }
 
 /// Per-step scratch arrays, kept between steps to avoid allocations.
@@ -218,7 +218,7 @@ impl FluidForces {
     }
 
     /// The faces bounding cell `c` along `axis` (low, high).
-    fn cell_faces(&self, c: [usize; 3], axis: usize) -> [usize; 2] {
+    pub(super) fn cell_faces(&self, c: [usize; 3], axis: usize) -> [usize; 2] {
         let grid = &self.grid;
         let lo = c;
         let mut hi = c;
@@ -257,12 +257,7 @@ impl FluidForces {
     ) {
         match (self.drag_update, self.drag_velocities) {
             (DragUpdate::EveryGasStep, _) => {
-                if !self.held.valid {
-                    self.evaluate_held(positions_m, velocities_m_per_s, radii_m, team);
-                }
-                for ((held, v), f) in self.held.forces.iter_mut().zip(velocities_m_per_s).zip(force.iter_mut()) {
-                    *f += held.force_at(v);
-                }
+                self.add_held_forces(positions_m, velocities_m_per_s, radii_m, force, team)
             }
             (DragUpdate::EveryDemStep, DragVelocities::Instantaneous) => {
                 self.add_forces_instantaneous(positions_m, velocities_m_per_s, radii_m, force, team)
@@ -274,6 +269,11 @@ impl FluidForces {
         self.momentum_exchange
             .iter_mut()
             .for_each(ExchangeAccumulator::end_sub_step);
+    }
+
+    /// The interpolation stencil of velocity component `a` at `x`.
+    pub(super) fn lattice_stencil(&self, a: usize, x: &Vec3) -> Stencil {
+        self.lattice[a].stencil(x)
     }
 
     /// −∇p interpolated to `x`.
@@ -371,7 +371,7 @@ impl FluidForces {
     }
 
     /// K of a particle of radius `r` in cell `c` at slip `slip` (the cell-averaged method).
-    fn cell_drag_coefficient(&self, c: usize, slip: &Vec3, r: f64) -> f64 {
+    pub(super) fn cell_drag_coefficient(&self, c: usize, slip: &Vec3, r: f64) -> f64 {
         self.drag.coefficient_n_s_per_m(&DragInput {
             porosity: self.porosity[c],
             slip_speed_m_per_s: slip.norm(),
@@ -383,7 +383,7 @@ impl FluidForces {
 
     /// K, the gas velocity u and the pressure force −V∇p at a particle at `x` moving at `v` with radius `r`, with
     /// the stencils of the velocity components at `x` in `stencils`.
-    fn evaluate(&self, x: &Vec3, v: &Vec3, r: f64, stencils: &mut [Stencil; 3]) -> (f64, Vec3, Vec3) {
+    pub(super) fn evaluate(&self, x: &Vec3, v: &Vec3, r: f64, stencils: &mut [Stencil; 3]) -> (f64, Vec3, Vec3) {
         let volume = 4.0 / 3.0 * PI * r * r * r;
         let eps = self.porosity[self.cell_of(x)];
         let mut u = Vec3::zeros();
@@ -411,84 +411,6 @@ impl FluidForces {
         let (k, u, pressure_force) = self.evaluate(x, v, r, stencils);
         let drag = (u - v) * k;
         (drag, k, drag + pressure_force)
-    }
-
-    /// Evaluates and holds every particle's K, u and pressure force under the present frozen field (the first
-    /// sub-step after a gas step, or a restore within one); the velocity sums start at zero.
-    fn evaluate_held(&mut self, positions_m: &[Vec3], velocities_m_per_s: &[Vec3], radii_m: &[f64], team: Option<&Team>) {
-        let mut held = std::mem::take(&mut self.held);
-        let n = positions_m.len();
-        held.forces.resize(n, Default::default());
-        held.stencils.resize(n, Default::default());
-        held.evaluated_at.clear();
-        held.evaluated_at.extend(positions_m.iter().copied().zip(velocities_m_per_s.iter().copied()));
-        let this = &*self;
-        let compute = |(i, (record, stencils)): (usize, (&mut super::held_drag::HeldForce, &mut [Stencil; 3]))| {
-            let (k, u, pressure_force) =
-                this.evaluate(&positions_m[i], &velocities_m_per_s[i], radii_m[i], stencils);
-            *record = super::held_drag::HeldForce {
-                coefficient_n_s_per_m: k,
-                gas_velocity_m_per_s: u,
-                pressure_force_n: pressure_force,
-                velocity_sum_m_per_s: Vec3::zeros(),
-            };
-        };
-        per_particle(team, &mut held.forces, &mut held.stencils, compute);
-        held.valid = true;
-        self.held = held;
-    }
-
-    /// Hands the gas the reaction of the held drag over the sub-steps since the last freeze (once, before the gas
-    /// step reads [`Self::mean_reaction`] or [`Self::mean_exchange`]): K (n u − Σv) per particle, spread with its
-    /// held stencils, serially in particle order. Does nothing under the every-step scheme, whose reaction is spread
-    /// as it goes.
-    pub fn settle_held_reaction(&mut self) {
-        if self.drag_update != DragUpdate::EveryGasStep || !self.held.valid {
-            return;
-        }
-        let steps = f64::from(self.steps());
-        let per_volume = 1.0 / self.grid.cell_volume_m3();
-        for (held, stencils) in self.held.forces.iter().zip(&self.held.stencils) {
-            let k = held.coefficient_n_s_per_m;
-            let drag_sum = (held.gas_velocity_m_per_s * steps - held.velocity_sum_m_per_s) * k;
-            for (a, stencil) in stencils.iter().enumerate().take(self.grid.axes()) {
-                let exchange = &mut self.momentum_exchange[a];
-                for c in 0..stencil.count {
-                    let (face, w) = (stencil.face[c], stencil.weight[c] * per_volume);
-                    exchange.add_transfer(face, -(w * drag_sum[a]));
-                    exchange.add_exchange_sums(face, w * k * steps, w * k * held.velocity_sum_m_per_s[a]);
-                }
-            }
-        }
-        self.held.valid = false;
-    }
-
-    /// The held-drag state for a checkpoint: `None` under the every-step scheme or before the first sub-step.
-    pub fn held_snapshot(&self) -> Option<HeldDragSnapshot> {
-        match self.drag_update {
-            DragUpdate::EveryGasStep => self.held.snapshot(),
-            DragUpdate::EveryDemStep => None,
-        }
-    }
-
-    /// Evaluates the held values again from a checkpoint's positions and velocities at the evaluation (the frozen
-    /// field must already be restored) and puts the velocity sums back.
-    pub fn restore_held(&mut self, snap: &HeldDragSnapshot, radii_m: &[f64]) -> Result<(), String> {
-        let n = radii_m.len();
-        for (what, len) in [
-            ("positions", snap.position_m.len()),
-            ("velocities", snap.velocity_m_per_s.len()),
-            ("velocity sums", snap.velocity_sum_m_per_s.len()),
-        ] {
-            if len != n {
-                return Err(format!("the checkpoint's held drag has {len} {what}, the run {n} particles"));
-            }
-        }
-        self.evaluate_held(&snap.position_m, &snap.velocity_m_per_s, radii_m, None);
-        for (held, sum) in self.held.forces.iter_mut().zip(&snap.velocity_sum_m_per_s) {
-            held.velocity_sum_m_per_s = *sum;
-        }
-        Ok(())
     }
 
     fn add_forces_instantaneous(
