@@ -387,6 +387,14 @@ impl BondForce {
 }
 
 impl Cohesion {
+    /// Whether a pair whose record holds `bridge_volume_m3` feels nothing from this model whatever its geometry: a
+    /// liquid-bridge model without a bridge ([`Self::force`] returns nothing and changes no state), so the pair pass
+    /// skips the bond.
+    #[inline]
+    pub fn inert_without_bridge(&self, bridge_volume_m3: f64) -> bool {
+        matches!(self.model, CohesionModel::LiquidBridge(_)) && bridge_volume_m3 <= 0.0
+    }
+
     /// The cohesion force of one bond at the current positions (velocities at the half step), updating the slot's
     /// square-well state. `bridge`: the constants of the slot's liquid bridge (for its current volume). `dt_s` turns
     /// the square well's crossing impulse into a force acting for one step (the two half kicks of velocity Verlet

@@ -123,6 +123,10 @@ fn exchange_bridges(
         };
         for k in pairs {
             let j = list.partner[k] as usize;
+            // No bridge and no liquid on either particle: nothing can form or rupture (a dry bed's every pair).
+            if pair_volume[k] == 0.0 && p.liquid_m3[i] == 0.0 && p.liquid_m3[j] == 0.0 {
+                continue;
+            }
             let (rj, sj) = (p.radius_m[j], p.species[j]);
             let d = config.domain.separation(&xi, &p.position_m[j]);
             let reach = ri + rj;
@@ -159,7 +163,8 @@ fn exchange_bridges(
         if cohesion.wall_range_m > 0.0 {
             for k in list.walls_of(i) {
                 let w = list.wall_partner[k] as usize;
-                if !cohesion.wall_on.get(w).copied().unwrap_or(true) {
+                if !cohesion.wall_on.get(w).copied().unwrap_or(true) || (wall_volume[k] == 0.0 && p.liquid_m3[i] == 0.0)
+                {
                     continue;
                 }
                 let wall = &config.walls[w];

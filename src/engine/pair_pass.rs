@@ -434,6 +434,9 @@ impl<'a> Context<'a> {
             hist.release_as::<P>(k);
             // Apart: the cohesion model alone, while in range or carrying a bridge or well.
             let c = cohesion?;
+            if c.inert_without_bridge(hist.cohesion.bridge_volume_m3[k]) {
+                return None;
+            }
             let range = reach + c.range_m;
             if dist2 >= range * range && cohesion_state(hist, k).is_empty() {
                 return None;
@@ -490,6 +493,7 @@ impl<'a> Context<'a> {
         };
         match cohesion {
             None => Some(contact),
+            Some(c) if c.inert_without_bridge(hist.cohesion.bridge_volume_m3[k]) => Some(contact),
             Some(c) => {
                 let bond = self.pair_bond(c, bi, j, vel, d, dist2, reach, hist, k, slot, crossings);
                 if P::HEAT {
@@ -753,7 +757,7 @@ impl<'a> Context<'a> {
         };
         let gap = prox.gap_m - ri;
         let mut state = cohesion_state(hist, k);
-        if gap >= c.wall_range_m && state.is_empty() {
+        if (gap >= c.wall_range_m && state.is_empty()) || c.inert_without_bridge(state.bridge_volume_m3) {
             return (contact, None, flows);
         }
         let n = prox.normal;
