@@ -531,7 +531,7 @@ fn a_restored_scalar_continues_with_the_same_bits() {
     );
     let (mut b, _) = bed(s);
     b.positions.clone_from(&a.positions);
-    b.gas.restore(&snap).unwrap();
+    b.gas.restore(&snap, &[]).unwrap();
     a.advance(0.01);
     b.advance(0.01);
     let (x, y) = (a.gas.snapshot(), b.gas.snapshot());
@@ -544,6 +544,6 @@ fn a_restored_scalar_continues_with_the_same_bits() {
     }
     let mut without = snap.clone();
     without.scalars.clear();
-    let err = b.gas.restore(&without).unwrap_err();
+    let err = b.gas.restore(&without, &[]).unwrap_err();
     assert!(err.contains("temperature_k"), "{err}");
 }

@@ -566,4 +566,45 @@ mod tests {
             assert!((share - 0.5).abs() < 1e-12, "V̂ = {v_hat}: computed share {share}");
         }
     }
+
+    /// The pair pass skips the bond of a pair the liquid-bridge model leaves alone: exactly the pairs whose bond
+    /// gives no force and changes no state, at any gap, approach speed or viscosity; the other models never skip.
+    #[test]
+    fn only_a_liquid_bridge_without_a_bridge_is_inert() {
+        use crate::engine::particles::{Species, SpeciesTable};
+        let species = SpeciesTable {
+            species: vec![Species::test_bead("bead", 1.35e-3, 2000.0)],
+        };
+        let bridge = CohesionModel::LiquidBridge(
+            serde_norway::from_str("{ surface_tension_n_per_m: 0.02, viscosity_pa_s: 0.001 }").unwrap(),
+        );
+        let cohesion = Cohesion::new(bridge, &species, &[], 1.35e-3).expect("valid cohesion");
+        assert!(cohesion.inert_without_bridge(0.0));
+        assert!(!cohesion.inert_without_bridge(1e-12));
+        for (gap_m, approach_m_per_s) in [(-1e-5, 0.3), (0.0, -0.2), (2e-5, 1.0), (1e-3, 0.0)] {
+            let bond = Bond {
+                normal: Vec3::new(0.0, 1.0, 0.0),
+                gap_m,
+                centre_distance_m: 2.7e-3 + gap_m,
+                well_distance_m: 2.8e-3,
+                effective_radius_m: 0.675e-3,
+                effective_mass_kg: 1e-5,
+                approach_m_per_s,
+                contact_velocity: Vec3::new(0.1, -approach_m_per_s, 0.0),
+                depth_factor: 1.0,
+            };
+            let mut state = CohesionHistory {
+                bridge_volume_m3: 0.0,
+                in_well: false,
+            };
+            let out = cohesion.force(&bond, &mut state, &BridgeConstants::NONE, 1e-5);
+            assert_eq!(out, BondForce::NONE);
+            assert!(state.is_empty());
+        }
+        let hamaker = CohesionModel::Hamaker(
+            serde_norway::from_str("{ constant_j: 1.0e-19, inner_cutoff_m: 4.0e-10, outer_cutoff_m: 1.0e-5 }").unwrap(),
+        );
+        let cohesion = Cohesion::new(hamaker, &species, &[], 1.35e-3).expect("valid cohesion");
+        assert!(!cohesion.inert_without_bridge(0.0));
+    }
 }
