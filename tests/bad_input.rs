@@ -53,6 +53,18 @@ const CASES: &[(&str, &str, &str, &[&str])] = &[
         &["bad.yaml", "neighbor.inner_skin_m", "<= neighbor.skin_m"],
     ),
     (
+        "a sort every zero steps",
+        "time: { dt_s: 1.0e-5, end_time_s: 0.001 }",
+        "time: { dt_s: 1.0e-5, end_time_s: 0.001 }\nneighbor: { sort_every_steps: 0 }",
+        &["bad.yaml", "neighbor.sort_every_steps", "at least 1"],
+    ),
+    (
+        "a sort period that is not a whole number",
+        "time: { dt_s: 1.0e-5, end_time_s: 0.001 }",
+        "time: { dt_s: 1.0e-5, end_time_s: 0.001 }\nneighbor: { sort_every_steps: 2.5 }",
+        &["bad.yaml:", "sort_every_steps"],
+    ),
+    (
         "a spinning particle that cannot rotate",
         "fill:\n  - lattice: { species: glass, spacing_m: 0.0025, lo_m: [0.001, 0.001, 0.001], hi_m: [0.019, 0.019, 0.02] }",
         "rotation: false\nfill:\n  - explicit: { species: glass, positions_m: [[0.01, 0.01, 0.01]], angular_velocities_rad_per_s: [[0.0, 5.0, 0.0]] }",

@@ -145,6 +145,18 @@ macro_rules! scalar_channels {
             pub fn heap_bytes(&self) -> usize {
                 0 $( + self.$name.capacity() * std::mem::size_of::<f64>() )*
             }
+
+            /// The channels of the particles in a new order: particle k of the result is particle `order[k]` of
+            /// these (`engine::particle_order`); columns that are off stay empty.
+            pub fn permuted(&self, order: &[usize]) -> Self {
+                ParticleChannels {
+                    $( $name: if self.$name.is_empty() {
+                        Vec::new()
+                    } else {
+                        order.iter().map(|&i| self.$name[i]).collect()
+                    }, )*
+                }
+            }
         }
 
         impl ChannelsMut<'_> {

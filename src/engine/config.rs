@@ -34,6 +34,9 @@ pub struct SimConfig {
     /// The inner skin was not chosen by the scenario: use two levels only after cell searches where it halves the
     /// force pass's candidates (otherwise one level until the next search).
     pub inner_skin_auto: bool,
+    /// Sort the particles by place after every step whose number is a multiple of this (`engine::particle_order`);
+    /// `None`: never (the particles keep the order they were filled in).
+    pub sort_every_steps: Option<u64>,
     /// Largest tolerated overlap as a fraction of the smaller radius; beyond it the step fails.
     pub max_overlap_fraction: f64,
     /// Forces at a distance (liquid bridges, van der Waals, square well); `None`: dry, cohesionless particles.

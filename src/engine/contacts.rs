@@ -23,9 +23,10 @@ pub struct WallId(pub u16);
 /// liquid bridge): everything about pairs that a checkpoint must hold.
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct ContactStore {
-    /// Particle–particle records, sorted by (i, j), i < j.
+    /// Particle–particle records, sorted by (i, j), i < j. The keys are the particles' array indices (their ids
+    /// only until the run sorts its particles, `engine::particle_order`).
     pub pairs: Vec<(ParticleId, ParticleId, ContactHistory)>,
-    /// Particle–wall records, sorted by (i, wall).
+    /// Particle–wall records, sorted by (i, wall), i an array index.
     pub walls: Vec<(ParticleId, WallId, ContactHistory)>,
 }
 

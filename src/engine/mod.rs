@@ -16,6 +16,7 @@ pub mod models;
 pub mod neighbor;
 pub mod net_force;
 pub mod pair_pass;
+pub mod particle_order;
 pub mod particles;
 pub mod range_plan;
 pub mod simulation;

@@ -149,11 +149,12 @@ impl WorstOverlap {
         }
     }
 
-    pub fn partner_name(&self, walls: &[Wall]) -> String {
+    /// The partner as a message names it: the wall's name, or the particle's id (`ids` by index).
+    pub fn partner_name(&self, walls: &[Wall], ids: &[ParticleId]) -> String {
         if self.partner >= u32::MAX - walls.len() as u32 {
             format!("wall '{}'", walls[(u32::MAX - self.partner) as usize].name)
         } else {
-            format!("particle {}", ParticleId(self.partner).0)
+            format!("particle {}", ids[self.partner as usize].0)
         }
     }
 }

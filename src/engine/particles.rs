@@ -2,8 +2,9 @@
 //!
 //! Hot loops touch one or two fields of many particles at a time (positions in the neighbour search, velocities in
 //! the integrator), so each field is its own contiguous array rather than a `Vec<Particle>`. A particle's
-//! [`ParticleId`] is stable for the life of a simulation and is what checkpoints and contact keys store; the array
-//! index is the id (particles are never reordered or removed in this version). Per-pair material mixing lives in
+//! [`ParticleId`] is stable for the life of a simulation (its fill order) and checkpoints store it; the array index
+//! equals the id until the run sorts its particles by place (`engine::particle_order`), after which a particle is
+//! found by its id. Contact records are keyed by array index. Per-pair material mixing lives in
 //! `models::pair_table`, not here.
 
 use serde::{Deserialize, Serialize};
@@ -169,6 +170,35 @@ impl Particles {
         self.liquid_m3.push(species.liquid_content * radius_m.powi(3));
         self.sprayed_m3.push(0.0);
         id
+    }
+
+    /// The particles in a new order: particle k of the result is particle `order[k]` of these, with its id and
+    /// every per-particle array (`engine::particle_order`). `order` must be a permutation of `0..len`.
+    pub fn permuted(&self, order: &[usize]) -> Particles {
+        fn gather<T: Copy>(column: &[T], order: &[usize]) -> Vec<T> {
+            if column.is_empty() {
+                Vec::new()
+            } else {
+                order.iter().map(|&i| column[i]).collect()
+            }
+        }
+        debug_assert_eq!(order.len(), self.len());
+        Particles {
+            id: gather(&self.id, order),
+            species: gather(&self.species, order),
+            radius_m: gather(&self.radius_m, order),
+            mass_kg: gather(&self.mass_kg, order),
+            inertia_kg_m2: gather(&self.inertia_kg_m2, order),
+            position_m: gather(&self.position_m, order),
+            velocity_m_per_s: gather(&self.velocity_m_per_s, order),
+            angular_velocity_rad_per_s: gather(&self.angular_velocity_rad_per_s, order),
+            force_n: gather(&self.force_n, order),
+            torque_n_m: gather(&self.torque_n_m, order),
+            liquid_m3: gather(&self.liquid_m3, order),
+            sprayed_m3: gather(&self.sprayed_m3, order),
+            temperature_k: gather(&self.temperature_k, order),
+            channels: self.channels.permuted(order),
+        }
     }
 
     pub fn max_radius_m(&self) -> f64 {

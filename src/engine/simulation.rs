@@ -19,7 +19,8 @@ use super::liquid::{BridgeCache, step_liquid, total_liquid_m3};
 use super::neighbor::{Criteria, NeighborList};
 use super::net_force::NetForceTally;
 use super::pair_pass::{ForcePass, HalfKick, PairBuffers, add_wall_forces, compute_pair_forces};
-use super::particles::{ParticleId, Particles};
+use super::particle_order::{reorder_state, spatial_order};
+use super::particles::Particles;
 use super::range_plan::RangePlan;
 use super::state::{RngState, SimState};
 use super::team::Team;
@@ -181,11 +182,11 @@ impl Simulation {
         let inverse = InverseInertia::new(&state.particles, config.rotation, config.heat.as_ref());
         let mut sim = Simulation {
             config,
-            particles: state.particles,
-            step: state.step,
-            time_s: state.time_s,
+            particles: Particles::default(),
+            step: 0,
+            time_s: 0.0,
             dt_s: state.dt_s,
-            wall_angle_rad: state.wall_angle_rad,
+            wall_angle_rad: Vec::new(),
             rng: state.rng,
             history: AlignedHistory::default(),
             work: Workspace::new(inverse, threads),
@@ -193,20 +194,57 @@ impl Simulation {
             cohesion_events: CohesionEvents::default(),
             sprayed_m3: 0.0,
             gas: None,
-            net_force: state.net_force,
+            net_force: None,
             timers: StageTimers::default(),
         };
-        let team = Arc::clone(&sim.work.team);
-        sim.build_lists(true, &team);
-        let layout = sim.config.history_layout();
+        sim.load(state)?;
+        Ok(sim)
+    }
+
+    /// Puts `state` (its gas aside, which is [`Self::restore_gas`]'s) in place of this simulation's state and
+    /// rebuilds the workspace from it, keeping the thread team, the timers and the event counters: a restore, and
+    /// the second half of a sort, so that a sorted run continues exactly as one resumed from its checkpoint would.
+    fn load(&mut self, state: SimState) -> Result<(), NumericalError> {
+        self.work.inverse = InverseInertia::new(&state.particles, self.config.rotation, self.config.heat.as_ref());
+        self.particles = state.particles;
+        self.step = state.step;
+        self.time_s = state.time_s;
+        self.dt_s = state.dt_s;
+        self.wall_angle_rad = state.wall_angle_rad;
+        self.rng = state.rng;
+        self.net_force = state.net_force;
+        self.work.bridges = BridgeCache::default();
+        self.work.pending_drift = None;
+        self.work.accumulators_zeroed = false;
+        let team = Arc::clone(&self.work.team);
+        self.build_lists(true, &team);
+        let layout = self.config.history_layout();
         let (history, orphans) =
-            AlignedHistory::from_store(&state.contacts, &sim.work.list, layout, &mut sim.particles.liquid_m3);
+            AlignedHistory::from_store(&state.contacts, &self.work.list, layout, &mut self.particles.liquid_m3);
         if orphans > 0 {
             return Err(NumericalError::OrphanContacts { count: orphans });
         }
-        sim.history = history;
-        sim.rebalance();
-        Ok(sim)
+        self.history = history;
+        self.rebalance();
+        Ok(())
+    }
+
+    /// Sorts the particles by place (`engine::particle_order`, `neighbor.sort_every_steps`): the state is taken as
+    /// a checkpoint would take it, put in the new order, and loaded back as a restore would load it.
+    fn sort_particles(&mut self) -> Result<(), NumericalError> {
+        let t = Instant::now();
+        let mut state = self.snapshot();
+        let order = spatial_order(&state.particles.position_m, 2.0 * self.particles.max_radius_m());
+        reorder_state(&mut state, &order);
+        let gas = state.gas.take();
+        self.load(state)?;
+        if let (Some(coupling), Some(snap)) = (self.gas.as_mut(), gas) {
+            coupling
+                .restore(&snap, &self.particles.radius_m)
+                .expect("the gas takes back its own snapshot, its particles reordered");
+        }
+        self.timers.neighbor += t.elapsed();
+        Ok(())
     }
 
     /// The complete state, for checkpoints and comparisons.
@@ -305,9 +343,17 @@ impl Simulation {
                 .gas
                 .as_ref()
                 .is_some_and(|g| (self.step + 1).is_multiple_of(g.dem_steps_per_gas_step));
-            self.step_inner(k + 1 < n && !gas_due)?;
+            // A sort too sees whole steps (it takes the state as a checkpoint does).
+            let sort_due = self
+                .config
+                .sort_every_steps
+                .is_some_and(|every| (self.step + 1).is_multiple_of(every));
+            self.step_inner(k + 1 < n && !gas_due && !sort_due)?;
             if gas_due {
                 self.advance_gas()?;
+            }
+            if sort_due {
+                self.sort_particles()?;
             }
             Ok(())
         });
@@ -391,13 +437,13 @@ impl Simulation {
                 return Err(if (position_m.x + position_m.y + position_m.z).is_finite() {
                     NumericalError::ParticleLost {
                         step: self.step,
-                        particle: ParticleId(i as u32),
+                        particle: self.particles.id[i],
                         position_m,
                     }
                 } else {
                     NumericalError::NonFinite {
                         step: self.step,
-                        particle: ParticleId(i as u32),
+                        particle: self.particles.id[i],
                         field: "position",
                     }
                 });
@@ -495,7 +541,7 @@ impl Simulation {
         };
         NumericalError::NonFinite {
             step: self.step,
-            particle: ParticleId(i as u32),
+            particle: p.id[i],
             field,
         }
     }
@@ -504,8 +550,8 @@ impl Simulation {
         if worst.ratio > self.config.max_overlap_fraction {
             return Err(NumericalError::ExcessiveOverlap {
                 step: self.step,
-                particle: ParticleId(worst.particle),
-                partner: worst.partner_name(&self.config.walls),
+                particle: self.particles.id[worst.particle as usize],
+                partner: worst.partner_name(&self.config.walls, &self.particles.id),
                 overlap_m: worst.overlap_m,
                 ratio: worst.ratio,
                 limit: self.config.max_overlap_fraction,

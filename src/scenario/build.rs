@@ -165,6 +165,12 @@ pub fn build(spec: ScenarioSpec, path: &Path) -> Result<BuiltScenario, ConfigErr
             format!("expected 0 < value <= neighbor.skin_m ({skin_m} m), got {inner_skin_m}"),
         ));
     }
+    if spec.neighbor.sort_every_steps == Some(0) {
+        return Err(c.fail(
+            "neighbor.sort_every_steps",
+            "expected a number of steps of at least 1 (leave the key out to never sort)",
+        ));
+    }
     c.positive("time.end_time_s", spec.time.end_time_s)?;
     c.positive("time.reference_velocity_m_per_s", spec.time.reference_velocity_m_per_s)?;
     if !(spec.max_overlap_fraction.is_finite() && spec.max_overlap_fraction > 0.0 && spec.max_overlap_fraction <= 1.0) {
@@ -315,6 +321,7 @@ pub fn build(spec: ScenarioSpec, path: &Path) -> Result<BuiltScenario, ConfigErr
         skin_m,
         inner_skin_m,
         inner_skin_auto: spec.neighbor.inner_skin_m.is_none(),
+        sort_every_steps: spec.neighbor.sort_every_steps,
         max_overlap_fraction: spec.max_overlap_fraction,
         cohesion,
         contact_statistics: spec.output.contact_statistics,

@@ -489,6 +489,15 @@ pub struct NeighborSpec {
     /// halves the pairs the force pass examines (dense, slow beds); given: always; equal to skin_m: one list.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub inner_skin_m: Option<f64>,
+    /// Sort the particles by place every this many steps (cells of one largest diameter, slabs across the bed's
+    /// widest spread), as LAMMPS' `atom_modify sort` does: a bed that mixes otherwise scatters neighbours through
+    /// memory, and on several threads nearly every pair then crosses between the threads' ranges (a bubbling bed of
+    /// 2,400 beads ran its contact pass 1.75× slower on two threads than on one). Results stay independent of the
+    /// thread count and restarts stay exact; a sorted run's bits differ from an unsorted one's (forces are summed in
+    /// another order), its physics does not. Default: never (the particles keep their fill order). 1000 suits most
+    /// beds.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub sort_every_steps: Option<u64>,
 }
 
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize, schemars::JsonSchema)]

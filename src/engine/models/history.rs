@@ -432,6 +432,23 @@ contact_history! {
     }
 }
 
+impl ContactHistory {
+    /// The record of the same pair with its particles exchanged (the particles were reordered and the pair is now
+    /// kept under its other particle, `engine::particle_order`): every vector field negated, scalars and flags as
+    /// they are. A vector field is particle i's side of the contact (the tangential displacement of i relative to j,
+    /// the tangential force on i, their directions), which exchanging i and j reverses; a scalar or flag belongs to
+    /// the pair. A new vector field that is not i's side must say so here.
+    pub fn mirrored(&self) -> ContactHistory {
+        let mut h = *self;
+        for field in HISTORY_FIELDS {
+            if let FieldValue::Vector(v) = (field.get)(self) {
+                (field.set)(&mut h, FieldValue::Vector(-v));
+            }
+        }
+        h
+    }
+}
+
 impl CohesionHistory {
     /// No bridge and not in a well.
     pub fn is_empty(&self) -> bool {
@@ -453,6 +470,30 @@ pub fn rotate_into_tangent_plane(v: Vec3, n: &Vec3) -> Vec3 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Exchanging a pair's particles negates every vector field (i's side of the contact) and keeps the rest.
+    #[test]
+    fn a_mirrored_record_negates_its_vectors_and_keeps_its_scalars_and_flags() {
+        let mut h = ContactHistory::INACTIVE;
+        h.active = true;
+        for (k, f) in HISTORY_FIELDS.iter().enumerate() {
+            let value = match f.kind {
+                FieldKind::Flag => FieldValue::Flag(true),
+                FieldKind::Scalar => FieldValue::Scalar(k as f64 + 0.5),
+                FieldKind::Vector => FieldValue::Vector(Vec3::new(k as f64 + 1.0, -2.0, 3.5)),
+            };
+            (f.set)(&mut h, value);
+        }
+        let m = h.mirrored();
+        assert_eq!(m.active, h.active);
+        for f in HISTORY_FIELDS {
+            match ((f.get)(&h), (f.get)(&m)) {
+                (FieldValue::Vector(a), FieldValue::Vector(b)) => assert_eq!(b, -a, "{}", f.name),
+                (a, b) => assert_eq!(a, b, "{}", f.name),
+            }
+        }
+        assert_eq!(m.mirrored(), h);
+    }
 
     /// Every field is listed once, reads back what is set through the table, and lives in the slot it names.
     #[test]
