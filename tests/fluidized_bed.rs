@@ -610,3 +610,36 @@ fn jets_through_a_wall_make_the_inlet_side_and_its_superficial_velocity() {
     let gas = final_gas(dir, "wall-jet", &text);
     assert_eq!(&gas.velocity_m_per_s[1][..4], &[0.0, 10.0, 0.0, 0.0]);
 }
+
+/// A gas state taken inside a gas step carries the drag scheme's sums: one written under drag held over the gas step
+/// is refused by a scenario that evaluates drag every DEM step, and the other way round, with a message that names
+/// `gas.drag_update`. (The binary refuses such a resume earlier, because the scenarios differ; this is the last
+/// line of defence for a checkpoint put beside another scenario.)
+#[test]
+fn a_gas_state_inside_a_gas_step_is_refused_under_the_other_drag_update() {
+    let snapshot_after = |extra: &str, steps: u64| {
+        let b = common::built(&bed(0.03, extra));
+        let mut sim = common::simulation(&b, 1);
+        granflow::simulate::attach_gas(&b, &mut sim, None).expect("the gas attaches");
+        sim.run_steps(steps).expect("stable");
+        sim.gas.as_ref().expect("a gas").snapshot()
+    };
+    let restore_into = |extra: &str, snap: &GasSnapshot| {
+        let b = common::built(&bed(0.03, extra));
+        let mut sim = common::simulation(&b, 1);
+        granflow::simulate::attach_gas(&b, &mut sim, None).expect("the gas attaches");
+        sim.restore_gas(snap)
+    };
+    // 703 steps: 3 DEM steps into a gas step of 7.
+    let held = snapshot_after("  drag_update: every_gas_step", 703);
+    let every_step = snapshot_after("", 703);
+    assert!(held.held_drag.is_some() && every_step.held_drag.is_none());
+    assert_eq!((held.reaction_steps, every_step.reaction_steps), (3, 3));
+    let err = restore_into("", &held).expect_err("held drag into an every-step scenario");
+    assert!(err.contains("every_dem_step"), "{err}");
+    let err = restore_into("  drag_update: every_gas_step", &every_step).expect_err("the other way round");
+    assert!(err.contains("every_gas_step") && err.contains("3 DEM steps"), "{err}");
+    // Each scheme takes back its own.
+    restore_into("  drag_update: every_gas_step", &held).expect("held into held");
+    restore_into("", &every_step).expect("every step into every step");
+}
