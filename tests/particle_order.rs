@@ -9,34 +9,21 @@ use common::{built, simulation, whole_and_resumed};
 use granflow::engine::state::{SimState, first_difference};
 use granflow::engine::{Simulation, Vec3};
 
-/// A wet drum (seed 000's liquid bridges, sprayed liquid, Walton-Braun friction with its vector histories) turning
-/// at 120 rpm: the particles mix, so every sort moves many of them.
-const WET_DRUM: &str = r#"
-name: sorted-wet-drum
-domain: { lo_m: [-0.041, -0.041, 0.0], hi_m: [0.041, 0.041, 0.012], periodic: [false, false, true] }
-gravity: { vector_m_per_s2: [0.0, -9.81, 0.0] }
-species:
-  - { name: a, radius_m: 0.0015, density_kg_per_m3: 2500.0, youngs_modulus_pa: 5.0e7, poisson_ratio: 0.3, friction_coefficient: 0.4, contact_angle_deg: 20.0, liquid_content: 0.01 }
-  - { name: b, radius_m: 0.0015, density_kg_per_m3: 2500.0, youngs_modulus_pa: 5.0e7, poisson_ratio: 0.3, friction_coefficient: 0.4, contact_angle_deg: 50.0, liquid_content: 0.01 }
-contact: { normal: { hertz: { restitution: 0.6 } }, tangential: { walton_braun: {} } }
-cohesion: { liquid_bridge: { surface_tension_n_per_m: 0.072, viscosity_pa_s: 0.001, walls: true, spray: { max_liquid_content: 0.02, every_steps: 50 } } }
-walls:
-  - drum:
-      name: drum
-      species: a
-      axis_point_m: [0.0, 0.0, 0.0]
-      axis: [0.0, 0.0, 1.0]
-      radius_m: 0.04
-      rotation_rpm: 120.0
-      baffles:
-        - traditional: { count: 4, length_m: 0.01, half_thickness_m: 0.001, tilt_deg: 0.0 }
-fill:
-  - lattice: { species: a, spacing_m: 0.0032, lo_m: [-0.04, -0.04, 0.0], hi_m: [-0.001, 0.01, 0.0105], origin_m: [0.0, 0.0, 0.0015], inside_drum: drum }
-  - lattice: { species: b, spacing_m: 0.0032, lo_m: [0.0, -0.04, 0.0], hi_m: [0.04, 0.01, 0.0105], origin_m: [0.0, 0.0, 0.0015], inside_drum: drum }
-time: { dt_s: 1.0e-5, end_time_s: 0.03 }
-output: { checkpoint_every_steps: 500, keep_checkpoints: 2, series_every_steps: 500 }
-seed: 5
-"#;
+/// The wet drum of the cohesion tests (seed 000's liquid bridges, sprayed liquid, two species) with Walton-Braun
+/// friction and its vector histories, 0.03 s: the drum turns at 120 rpm and mixes, so every sort moves many beads.
+fn wet_drum() -> String {
+    let mut yaml = common::WET_DRUM.to_string();
+    for (from, to) in [
+        ("name: wet-drum", "name: sorted-wet-drum"),
+        ("tangential: mindlin", "tangential: { walton_braun: {} }"),
+        ("end_time_s: 0.08", "end_time_s: 0.03"),
+        ("checkpoint_every_steps: 2000", "checkpoint_every_steps: 500"),
+    ] {
+        assert!(yaml.contains(from), "the wet drum has {from}");
+        yaml = yaml.replace(from, to);
+    }
+    yaml
+}
 
 /// A pseudo-2-D bed bubbling under 3.5 m/s, drag held over the gas step (7 DEM steps), cell-averaged and
 /// semi-implicit: a sort every 50 steps falls inside gas steps, where the held drag must follow its particles.
@@ -82,7 +69,7 @@ fn reordered_particles(s: &SimState) -> usize {
 fn a_sorted_wet_drum_restarts_bit_identically_across_a_sort() {
     let tmp = tempfile::tempdir().expect("temp dir");
     // The stop at step 1500 is itself a sort step: the checkpoint holds the sorted state.
-    let (whole, split) = whole_and_resumed(tmp.path(), &sorted(WET_DRUM, 100), 1500);
+    let (whole, split) = whole_and_resumed(tmp.path(), &sorted(&wet_drum(), 100), 1500);
     assert_eq!(whole.step, 3000);
     let moved = reordered_particles(&whole);
     let bridges = whole
@@ -122,7 +109,7 @@ fn a_sorted_bed_with_held_drag_restarts_bit_identically_inside_a_gas_step() {
 
 #[test]
 fn a_sorted_run_gives_the_same_bits_on_one_and_two_threads() {
-    for yaml in [sorted(WET_DRUM, 100), sorted(HELD_DRAG_BED, 50)] {
+    for yaml in [sorted(&wet_drum(), 100), sorted(HELD_DRAG_BED, 50)] {
         let b = built(&yaml);
         let states: Vec<SimState> = [1, 2]
             .iter()
@@ -147,8 +134,8 @@ fn a_sorted_run_gives_the_same_bits_on_one_and_two_threads() {
 /// particles by micrometres in that time.
 #[test]
 fn a_sorted_run_follows_the_unsorted_trajectories() {
-    let plain = built(WET_DRUM);
-    let every_10 = built(&sorted(WET_DRUM, 10));
+    let plain = built(&wet_drum());
+    let every_10 = built(&sorted(&wet_drum(), 10));
     let mut start = simulation(&plain, 1);
     start.run_steps(1500).expect("stable");
     let start = start.snapshot();

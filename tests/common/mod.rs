@@ -76,3 +76,33 @@ pub fn thermal_energy_j(s: &granflow::engine::state::SimState, heat_capacity_j_p
         .map(|(m, t)| m * heat_capacity_j_per_kg_k * t)
         .sum()
 }
+
+/// A wet rotating drum: two species of 3 mm beads (contact angles 20° and 50°) carrying V̂ = 0.01 of water each,
+/// the lattice collapsing into the drum's bed while it turns, the bed's surface sprayed up to V̂ = 0.02 every 50
+/// steps, with bridges to the drum and its baffles as well.
+pub const WET_DRUM: &str = r#"
+name: wet-drum
+domain: { lo_m: [-0.041, -0.041, 0.0], hi_m: [0.041, 0.041, 0.012], periodic: [false, false, true] }
+gravity: { vector_m_per_s2: [0.0, -9.81, 0.0] }
+species:
+  - { name: a, radius_m: 0.0015, density_kg_per_m3: 2500.0, youngs_modulus_pa: 5.0e7, poisson_ratio: 0.3, friction_coefficient: 0.4, contact_angle_deg: 20.0, liquid_content: 0.01 }
+  - { name: b, radius_m: 0.0015, density_kg_per_m3: 2500.0, youngs_modulus_pa: 5.0e7, poisson_ratio: 0.3, friction_coefficient: 0.4, contact_angle_deg: 50.0, liquid_content: 0.01 }
+contact: { normal: { hertz: { restitution: 0.6 } }, tangential: mindlin }
+cohesion: { liquid_bridge: { surface_tension_n_per_m: 0.072, viscosity_pa_s: 0.001, walls: true, spray: { max_liquid_content: 0.02, every_steps: 50 } } }
+walls:
+  - drum:
+      name: drum
+      species: a
+      axis_point_m: [0.0, 0.0, 0.0]
+      axis: [0.0, 0.0, 1.0]
+      radius_m: 0.04
+      rotation_rpm: 120.0
+      baffles:
+        - traditional: { count: 4, length_m: 0.01, half_thickness_m: 0.001, tilt_deg: 0.0 }
+fill:
+  - lattice: { species: a, spacing_m: 0.0032, lo_m: [-0.04, -0.04, 0.0], hi_m: [-0.001, 0.01, 0.0105], origin_m: [0.0, 0.0, 0.0015], inside_drum: drum }
+  - lattice: { species: b, spacing_m: 0.0032, lo_m: [0.0, -0.04, 0.0], hi_m: [0.04, 0.01, 0.0105], origin_m: [0.0, 0.0, 0.0015], inside_drum: drum }
+time: { dt_s: 1.0e-5, end_time_s: 0.08 }
+output: { checkpoint_every_steps: 2000, keep_checkpoints: 2, series_every_steps: 500 }
+seed: 5
+"#;

@@ -333,20 +333,8 @@ pub fn direct_symmetric(sys: &StencilSystem, x: &mut [f64], remove_mean: bool) -
     let Some(b_norm) = right_hand_side_norm(sys, x) else {
         return SolveReport::ZERO_RIGHT_HAND_SIDE;
     };
-    let bw = bandwidth(sys);
+    let (mut l, bw) = lower_band(sys);
     let width = bw + 1;
-    // Row p of the lower band: l[p * width + (q + bw − p)] for q in p − bw ..= p (the diagonal last), first A,
-    // then overwritten by L (unit diagonal, not stored) and D⁻¹ in the diagonal slot.
-    let mut l = vec![0.0; n * width];
-    for p in 0..n {
-        l[p * width + bw] = sys.ap[p];
-        for k in 0..NEIGHBOURS {
-            let q = sys.nb[p][k];
-            if q != NONE && (q as usize) < p {
-                l[p * width + (q as usize + bw - p)] -= sys.anb[p][k];
-            }
-        }
-    }
     eliminate_band(&mut l, &sys.ap, n, bw);
     // L y = b, z = D⁻¹ y, Lᵀ x = z.
     x.copy_from_slice(&sys.b);
@@ -384,6 +372,25 @@ pub fn direct_symmetric(sys: &StencilSystem, x: &mut [f64], remove_mean: bool) -
         relative_residual,
         converged: relative_residual.is_finite(),
     }
+}
+
+/// The lower band of `sys` and its bandwidth bw: row p's entry for column q, p − bw ≤ q ≤ p, at
+/// l[p · (bw + 1) + (q + bw − p)] (the diagonal last). [`eliminate_band`] overwrites it with L (unit diagonal, not
+/// stored) and D⁻¹ in the diagonal slot.
+fn lower_band(sys: &StencilSystem) -> (Vec<f64>, usize) {
+    let (n, bw) = (sys.len(), bandwidth(sys));
+    let width = bw + 1;
+    let mut l = vec![0.0; n * width];
+    for p in 0..n {
+        l[p * width + bw] = sys.ap[p];
+        for k in 0..NEIGHBOURS {
+            let q = sys.nb[p][k];
+            if q != NONE && (q as usize) < p {
+                l[p * width + (q as usize + bw - p)] -= sys.anb[p][k];
+            }
+        }
+    }
+    (l, bw)
 }
 
 /// The right-looking LDLᵀ elimination of [`direct_symmetric`] on its band `l` (row p's entry for column j,
@@ -604,29 +611,12 @@ mod tests {
         }
     }
 
-    /// The band of `sys` as `direct_symmetric` lays it out, before elimination.
-    fn band(sys: &StencilSystem) -> (Vec<f64>, usize) {
-        let (n, bw) = (sys.len(), bandwidth(sys));
-        let width = bw + 1;
-        let mut l = vec![0.0; n * width];
-        for p in 0..n {
-            l[p * width + bw] = sys.ap[p];
-            for k in 0..NEIGHBOURS {
-                let q = sys.nb[p][k];
-                if q != NONE && (q as usize) < p {
-                    l[p * width + (q as usize + bw - p)] -= sys.anb[p][k];
-                }
-            }
-        }
-        (l, bw)
-    }
-
     /// The right-looking elimination gives the textbook left-looking factors to the bit (each entry gets the same
     /// products in the same order), on the baseline and on the x86-64-v3 compilation alike.
     #[test]
     fn right_looking_elimination_gives_the_left_looking_factors_to_the_bit() {
         let sys = neumann_2d(15, 45);
-        let (mut left, bw) = band(&sys);
+        let (mut left, bw) = lower_band(&sys);
         let (n, width) = (sys.len(), bw + 1);
         // Left-looking, as the factorisation was first written.
         let mut w = vec![0.0; width];
@@ -651,12 +641,12 @@ mod tests {
             };
         }
         let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
-        let (mut right, _) = band(&sys);
+        let (mut right, _) = lower_band(&sys);
         eliminate_band_body(&mut right, &sys.ap, n, bw);
         assert_eq!(bits(&right), bits(&left));
         #[cfg(target_arch = "x86_64")]
         if crate::machine::cpu_fast_path() {
-            let (mut fast, _) = band(&sys);
+            let (mut fast, _) = lower_band(&sys);
             // SAFETY: `cpu_fast_path` is true only where the CPU has every feature the function is compiled for.
             unsafe { eliminate_band_x86_64_v3(&mut fast, &sys.ap, n, bw) };
             assert_eq!(bits(&fast), bits(&left));
