@@ -126,7 +126,8 @@ gas (optional: a gas coupled to the particles, fluidized beds):
   porosity: volume_split (default) | centre_binning                      particle volume into cells
   convection: upwind (default) | hybrid
   solver: { relax_velocity, relax_pressure, max_outer_iterations, mass_tolerance, velocity_tolerance,
-            linear_tolerance, max_linear_iterations, pressure_solver: auto (default) | direct | conjugate_gradient }
+            linear_tolerance, max_linear_iterations, pressure_solver: auto (default) | direct | conjugate_gradient,
+            pressure_velocity: simple (default) | { piso: { correctors: 2 } } }
   inflow_ramp: { start_s, duration_s? }                                  off until start_s, then linear to full
   inflow_levels: { start_s?, hold_s, factors }                           held levels (seed 001's gas cycle)
 "#;

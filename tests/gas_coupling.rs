@@ -54,6 +54,7 @@ time: {{ dt_s: 1.0e-4, end_time_s: 2.0 }}
         linear_tolerance: 1e-10,
         max_linear_iterations: 1000,
         pressure_solver: Default::default(),
+        pressure_velocity: Default::default(),
         inlet_faces: Vec::new(),
         inflow_ramp: None,
         inflow_levels: None,

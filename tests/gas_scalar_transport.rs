@@ -36,6 +36,7 @@ fn config(grid: Grid, convection: Convection) -> GasConfig {
         linear_tolerance: 1e-15,
         max_linear_iterations: 5000,
         pressure_solver: Default::default(),
+        pressure_velocity: Default::default(),
         inlet_faces: Vec::new(),
         inflow_ramp: None,
         inflow_levels: None,

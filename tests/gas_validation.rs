@@ -18,6 +18,7 @@ fn config(grid: Grid, density: f64, viscosity: f64, convection: Convection) -> G
         linear_tolerance: 1e-10,
         max_linear_iterations: 2000,
         pressure_solver: Default::default(),
+        pressure_velocity: Default::default(),
         inlet_faces: Vec::new(),
         inflow_ramp: None,
         inflow_levels: None,

@@ -17,6 +17,7 @@ use crate::engine::gas::grid::side;
 use crate::engine::gas::heat::GasThermal;
 use crate::engine::gas::held_drag::DragUpdate;
 use crate::engine::gas::linsolve::PressureSolver;
+use crate::engine::gas::simple::PressureVelocity;
 use crate::engine::gas::simple::{InflowLevels, InflowRamp, InletFace};
 use crate::engine::gas::{Boundary, Convection, GasConfig, Grid};
 use crate::engine::models::drag::DragLaw;
@@ -186,6 +187,15 @@ pub struct GasSolverSpec {
     /// `conjugate_gradient`. Not written when `auto`, so existing job ids stay as they were.
     #[serde(default, skip_serializing_if = "is_auto")]
     pub pressure_solver: PressureSolver,
+    /// `simple` (default: outer iterations to the tolerances) or `{ piso: { correctors: 2 } }` (one momentum
+    /// predictor and that many pressure corrections per gas step, no outer iterations; CFDEM's transient coupling).
+    /// Not written when `simple`, so existing job ids stay as they were.
+    #[serde(default, skip_serializing_if = "is_simple")]
+    pub pressure_velocity: PressureVelocity,
+}
+
+fn is_simple(p: &PressureVelocity) -> bool {
+    *p == PressureVelocity::Simple
 }
 
 fn is_auto(s: &PressureSolver) -> bool {
@@ -225,6 +235,7 @@ impl Default for GasSolverSpec {
             linear_tolerance: d_linear_tol(),
             max_linear_iterations: d_linear_iter(),
             pressure_solver: PressureSolver::Auto,
+            pressure_velocity: PressureVelocity::Simple,
         }
     }
 }
@@ -343,6 +354,14 @@ pub fn build_gas(
         ));
     }
     let s = &spec.solver;
+    if let PressureVelocity::Piso { correctors } = s.pressure_velocity
+        && !(1..=20).contains(&correctors)
+    {
+        return Err(fail(
+            "gas.solver.pressure_velocity.piso.correctors".into(),
+            format!("expected 1 to 20 pressure corrections per gas step, got {correctors}"),
+        ));
+    }
     for (key, v) in [
         ("relax_velocity", s.relax_velocity),
         ("relax_pressure", s.relax_pressure),
@@ -578,6 +597,7 @@ pub fn build_gas(
         linear_tolerance: s.linear_tolerance,
         max_linear_iterations: s.max_linear_iterations,
         pressure_solver: s.pressure_solver,
+        pressure_velocity: s.pressure_velocity,
         inlet_faces,
         inflow_ramp: spec.inflow_ramp,
         inflow_levels: spec.inflow_levels.clone(),
