@@ -60,8 +60,8 @@ fn final_gas(dir: &Path, name: &str, text: &str) -> GasSnapshot {
     final_state(&dir.join(name)).gas.expect("the checkpoint holds the gas")
 }
 
-/// The value of column `name` in the last row of series text `series`.
-fn last_row_value(series: &str, name: &str) -> f64 {
+/// The values of column `name` in every row of series text `series`, first row first.
+fn column_values(series: &str, name: &str) -> Vec<f64> {
     let k = series
         .lines()
         .next()
@@ -71,13 +71,14 @@ fn last_row_value(series: &str, name: &str) -> f64 {
         .unwrap_or_else(|| panic!("column {name}"));
     series
         .lines()
-        .last()
-        .unwrap()
-        .split(',')
-        .nth(k)
-        .unwrap()
-        .parse()
-        .unwrap()
+        .skip(1)
+        .map(|l| l.split(',').nth(k).unwrap().parse().unwrap())
+        .collect()
+}
+
+/// The value of column `name` in the last row of series text `series`.
+fn last_row_value(series: &str, name: &str) -> f64 {
+    *column_values(series, name).last().expect("a row")
 }
 
 fn run_ok(args: &[&str], cwd: &Path) -> String {
@@ -135,20 +136,8 @@ fn a_piso_step_ends_with_continuity_and_the_bed_carries_its_weight() {
     };
     let piso = run("piso", "  solver: { pressure_velocity: { piso: {} } }");
     let simple = run("simple", "");
-    let column = |series: &str, name: &str| -> Vec<f64> {
-        let k = series
-            .lines()
-            .next()
-            .unwrap()
-            .split(',')
-            .position(|h| h == name)
-            .unwrap();
-        series
-            .lines()
-            .skip(2)
-            .map(|l| l.split(',').nth(k).unwrap().parse().unwrap())
-            .collect()
-    };
+    // The rows after the first (the state at t = 0, before any gas step).
+    let column = |series: &str, name: &str| column_values(series, name).split_off(1);
     let imbalance = column(&piso, "gas_mass_imbalance");
     let worst = imbalance.iter().fold(0.0f64, |m, &v| m.max(v));
     println!(

@@ -17,7 +17,7 @@ use crate::engine::gas::grid::side;
 use crate::engine::gas::heat::GasThermal;
 use crate::engine::gas::held_drag::DragUpdate;
 use crate::engine::gas::linsolve::PressureSolver;
-use crate::engine::gas::simple::PressureVelocity;
+use crate::engine::gas::piso::PressureVelocity;
 use crate::engine::gas::simple::{InflowLevels, InflowRamp, InletFace};
 use crate::engine::gas::{Boundary, Convection, GasConfig, Grid};
 use crate::engine::models::drag::DragLaw;

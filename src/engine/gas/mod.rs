@@ -13,6 +13,7 @@ pub mod heat;
 pub mod held_drag;
 pub mod linsolve;
 pub(crate) mod momentum_rows;
+pub mod piso;
 pub(crate) mod pressure_sides;
 pub mod scalar;
 pub mod simple;

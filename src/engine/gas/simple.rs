@@ -21,6 +21,7 @@ use super::linsolve::{
     direct_symmetric,
 };
 use super::momentum_rows::{Across, MomentumRow, NeighbourFace, momentum_rows};
+use super::piso::PressureVelocity;
 use super::pressure_sides::{PressureSide, pressure_sides};
 
 /// The convection scheme.
@@ -73,30 +74,6 @@ pub struct GasConfig {
     /// "the reference pressure 0 is designated on top of the kiln"): in a domain closed by walls and blocked cells
     /// it takes up the gas volume that moving particles displace. `None`: every open cell balances its mass.
     pub pressure_reference_cell: Option<usize>,
-}
-
-/// How a gas step couples pressure and velocity.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize, schemars::JsonSchema)]
-#[serde(rename_all = "snake_case", deny_unknown_fields)]
-pub enum PressureVelocity {
-    /// SIMPLE (Patankar 1980): momentum and pressure correction iterated, under-relaxed, until the mass imbalance and
-    /// the velocity change are below their tolerances (`max_outer_iterations` at most). The default.
-    #[default]
-    Simple,
-    /// PISO (Issa 1986, J. Comput. Phys. 62), as CFDEM's and OpenFOAM's transient solvers use it: one momentum
-    /// predictor without under-relaxation, then `correctors` pressure corrections, each solved exactly and applied
-    /// in full, with the coefficients of the predictor (the neighbours' velocity corrections left out, as in the
-    /// common SIMPLE-form implementation). No outer iterations: the splitting error is of the order of the time step,
-    /// and continuity holds after the last correction.
-    Piso {
-        /// Pressure corrections per gas step (2 in Issa's scheme).
-        #[serde(default = "default_piso_correctors")]
-        correctors: usize,
-    },
-}
-
-fn default_piso_correctors() -> usize {
-    2
 }
 
 /// The rotation of the blocked cells' walls.
@@ -360,7 +337,7 @@ impl GasSolver {
     }
 
     /// Sets boundary-face normal velocities (walls 0, inlets their velocity) and periodic aliases.
-    fn apply_boundary_velocities(&mut self) {
+    pub(super) fn apply_boundary_velocities(&mut self) {
         let grid = &self.config.grid;
         for a in 0..grid.axes() {
             for idx in all_indices(grid.face_dims(a)) {
@@ -405,7 +382,7 @@ impl GasSolver {
 
     /// Scales the outlet faces' velocities so that outflow = inflow through the other boundary faces minus the gas
     /// accumulating inside (global continuity), as a zero-gradient outlet needs.
-    fn balance_outlets(&mut self, dt_s: f64, old_porosity: &[f64]) {
+    pub(super) fn balance_outlets(&mut self, dt_s: f64, old_porosity: &[f64]) {
         let grid = &self.config.grid;
         let rho = self.config.density_kg_per_m3;
         let (mut inflow, mut outflow) = (0.0, 0.0);
@@ -606,7 +583,7 @@ impl GasSolver {
 
     /// Net mass outflow of each cell (kg/s) plus the accumulation term: the pressure-correction right-hand side
     /// with its sign flipped. `face_porosity` is [`GasSolver::face_porosities`] of the current porosity.
-    fn assemble_pressure_correction(
+    pub(super) fn assemble_pressure_correction(
         &self,
         dt_s: f64,
         old_porosity: &[f64],
@@ -753,7 +730,7 @@ impl GasSolver {
 
     /// Solves the momentum equation of every component for the velocities (SIMPLE's predictor, or PISO's with
     /// `relax_velocity` 1), storing the pressure-correction coefficients d.
-    fn predict_momentum(
+    pub(super) fn predict_momentum(
         &mut self,
         dt_s: f64,
         old: &[Vec<f64>; 3],
@@ -786,7 +763,7 @@ impl GasSolver {
 
     /// Solves the pressure-correction system `psys` for p' and applies it: p += `relax` p', each face velocity
     /// += d (p'_lo − p'_hi), then the boundary velocities, the outlets' balance and the reference pressure.
-    fn correct_pressure(
+    pub(super) fn correct_pressure(
         &mut self,
         psys: &StencilSystem,
         relax: f64,
@@ -823,36 +800,6 @@ impl GasSolver {
         self.apply_boundary_velocities();
         self.balance_outlets(dt_s, old_porosity);
         self.fix_reference_pressure();
-    }
-
-    /// One PISO step ([`PressureVelocity::Piso`]): the momentum predictor without under-relaxation, then
-    /// `correctors` pressure corrections applied in full; the report's mass imbalance is that after the last.
-    #[allow(clippy::too_many_arguments)]
-    fn piso(
-        &mut self,
-        dt_s: f64,
-        old: &[Vec<f64>; 3],
-        source: &[Vec<f64>; 3],
-        sink: &[Vec<f64>; 3],
-        old_porosity: &[f64],
-        face_porosity: &[Vec<f64>; 3],
-        correctors: usize,
-        report: &mut StepReport,
-    ) {
-        let relax_velocity = std::mem::replace(&mut self.config.relax_velocity, 1.0);
-        self.predict_momentum(dt_s, old, source, sink, report);
-        self.config.relax_velocity = relax_velocity;
-        self.apply_boundary_velocities();
-        self.balance_outlets(dt_s, old_porosity);
-        for _ in 0..correctors {
-            let (psys, _) = self.assemble_pressure_correction(dt_s, old_porosity, face_porosity);
-            self.correct_pressure(&psys, 1.0, dt_s, old_porosity, report);
-        }
-        let (_, imbalance) = self.assemble_pressure_correction(dt_s, old_porosity, face_porosity);
-        report.outer_iterations = 1;
-        report.mass_imbalance = imbalance;
-        report.velocity_change = 0.0;
-        report.converged = imbalance.is_finite();
     }
 }
 
