@@ -22,5 +22,6 @@ pub mod transported_scalar;
 pub use exchange_accumulator::ExchangeAccumulator;
 pub use field::{FieldLocation, GasField, GasFieldView};
 pub use grid::{Boundary, Grid};
+pub use piso::PressureVelocity;
 pub use simple::{Convection, GasConfig, GasSolver, GasState, StepReport};
 pub use transported_scalar::{GasScalarSpec, ScalarExchange, ScalarWall, TransportedScalar};

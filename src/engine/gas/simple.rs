@@ -336,8 +336,15 @@ impl GasSolver {
         }
     }
 
-    /// Sets boundary-face normal velocities (walls 0, inlets their velocity) and periodic aliases.
+    /// Sets boundary-face normal velocities (walls 0, inlets their velocity, outlets zero-gradient) and periodic
+    /// aliases.
     pub(super) fn apply_boundary_velocities(&mut self) {
+        self.set_boundary_velocities(Outlets::ZeroGradient);
+    }
+
+    /// [`GasSolver::apply_boundary_velocities`], with the outlet faces either set zero-gradient or left as they are
+    /// ([`Outlets::Held`]: PISO's corrections, which must not move a flux the pressure equation did not see).
+    pub(super) fn set_boundary_velocities(&mut self, outlets: Outlets) {
         let grid = &self.config.grid;
         for a in 0..grid.axes() {
             for idx in all_indices(grid.face_dims(a)) {
@@ -353,6 +360,7 @@ impl GasSolver {
                     let b = grid.boundary[side(a, along == grid.n[a])];
                     self.state.velocity_m_per_s[a][f] = match b {
                         Boundary::Inlet { velocity_m_per_s } => velocity_m_per_s[a] * self.inflow_factor,
+                        Boundary::Outlet if outlets == Outlets::Held => self.state.velocity_m_per_s[a][f],
                         Boundary::Outlet if grid.n[a] > 1 => {
                             // Zero gradient: the next face inwards (a return flow included; `balance_outlets` scales
                             // only the outflowing faces).
@@ -722,7 +730,14 @@ impl GasSolver {
                 report.converged = true;
                 break;
             }
-            self.correct_pressure(&psys, self.config.relax_pressure, dt_s, old_porosity, &mut report);
+            self.correct_pressure(
+                &psys,
+                self.config.relax_pressure,
+                dt_s,
+                old_porosity,
+                Outlets::ZeroGradient,
+                &mut report,
+            );
         }
         self.state.time_s += dt_s;
         report
@@ -762,13 +777,15 @@ impl GasSolver {
     }
 
     /// Solves the pressure-correction system `psys` for p' and applies it: p += `relax` p', each face velocity
-    /// += d (p'_lo − p'_hi), then the boundary velocities, the outlets' balance and the reference pressure.
+    /// += d (p'_lo − p'_hi), then the boundary velocities, the outlets' balance (only when `outlets` is
+    /// [`Outlets::ZeroGradient`]) and the reference pressure.
     pub(super) fn correct_pressure(
         &mut self,
         psys: &StencilSystem,
         relax: f64,
         dt_s: f64,
         old_porosity: &[f64],
+        outlets: Outlets,
         report: &mut StepReport,
     ) {
         let mut pc = vec![0.0; psys.len()];
@@ -797,8 +814,10 @@ impl GasSolver {
                 self.state.velocity_m_per_s[c][f] += self.d[c][f] * (pc[r.cell_lo] - pc[r.cell_hi]);
             }
         }
-        self.apply_boundary_velocities();
-        self.balance_outlets(dt_s, old_porosity);
+        self.set_boundary_velocities(outlets);
+        if outlets == Outlets::ZeroGradient {
+            self.balance_outlets(dt_s, old_porosity);
+        }
         self.fix_reference_pressure();
     }
 }
@@ -869,6 +888,15 @@ impl GasSolver {
 }
 
 /// Whether cell `c` is blocked.
+/// What a boundary update does to the outlet faces' velocities.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(super) enum Outlets {
+    /// Copied from the next face inwards (zero gradient), to be rescaled by `balance_outlets`.
+    ZeroGradient,
+    /// Left as they are.
+    Held,
+}
+
 pub(crate) fn cell_blocked(grid: &Grid, blocked: &[bool], c: [usize; 3]) -> bool {
     !blocked.is_empty() && blocked[grid.cell(c)]
 }
