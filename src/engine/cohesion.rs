@@ -14,7 +14,7 @@ use super::models::capillary::{
     MikamiBridge, lian_rupture_gap_m, viscous_normal_force_n, viscous_tangential_coefficient_n_s_per_m,
 };
 use super::models::capillary_table::CapillaryTable;
-use super::models::cohesion_law::{CapillaryForce, CohesionModel, square_well_crossing};
+use super::models::cohesion_law::{CapillaryForce, CohesionModel, LiquidBridge, square_well_crossing};
 use super::models::history::CohesionHistory;
 use super::models::liquid_transfer::rupture_share_of_i;
 use super::particles::{SpeciesId, SpeciesTable};
@@ -333,6 +333,21 @@ pub struct BridgeConstants {
     /// The pair's Young–Laplace table (index into `Cohesion::tables`), used instead of `mikami`.
     pub table: Option<u32>,
     pub rupture_gap_m: f64,
+    /// The bridge between touching surfaces (most bridges of a packed wet bed): its forces no longer depend on the
+    /// gap there, so they are computed once per volume rather than per step ([`Cohesion::force`]).
+    pub at_contact: BridgeAtContact,
+}
+
+/// A bridge's forces while its surfaces touch, computed by the same functions the kernel calls with the gap held
+/// at its floor (so the kernel's result is the same to the bit with or without them).
+#[derive(Debug, Clone, Copy)]
+pub struct BridgeAtContact {
+    /// The effective radius they were computed for (NaN: none), m.
+    pub effective_radius_m: f64,
+    /// The capillary force at a gap ≤ 0 (the force laws hold the gap at 0), N.
+    pub capillary_n: f64,
+    /// The viscous tangential coefficient at a gap ≤ `Cohesion::min_gap_m` (held at it), N s/m.
+    pub viscous_tangential_n_s_per_m: f64,
 }
 
 impl BridgeConstants {
@@ -341,6 +356,11 @@ impl BridgeConstants {
         mikami: MikamiBridge::ZERO,
         table: None,
         rupture_gap_m: 0.0,
+        at_contact: BridgeAtContact {
+            effective_radius_m: f64::NAN,
+            capillary_n: 0.0,
+            viscous_tangential_n_s_per_m: 0.0,
+        },
     };
 }
 
@@ -407,11 +427,11 @@ impl Cohesion {
                     return BondForce::NONE;
                 }
                 // Seed 000 eqs 2.16-2.17 (Mikami) or 6.5-6.28 (the Young–Laplace table); 2.19-2.20 (viscous).
-                let capillary = match bridge.table {
-                    Some(t) => {
-                        self.tables[t as usize].force_n(state.bridge_volume_m3, bond.gap_m, b.surface_tension_n_per_m)
-                    }
-                    None => bridge.mikami.force_n(bond.gap_m),
+                let at_contact = &bridge.at_contact;
+                let capillary = if bond.gap_m <= 0.0 && bridge.volume_m3 == state.bridge_volume_m3 {
+                    at_contact.capillary_n
+                } else {
+                    self.capillary_force_n(bridge, state.bridge_volume_m3, bond.gap_m, b.surface_tension_n_per_m)
                 };
                 let mut normal_n = -capillary;
                 let mut tangential_n = Vec3::zeros();
@@ -419,8 +439,11 @@ impl Cohesion {
                     let r = bond.effective_radius_m;
                     normal_n +=
                         viscous_normal_force_n(r, b.viscosity_pa_s, bond.approach_m_per_s, bond.gap_m, self.min_gap_m);
-                    let coefficient =
-                        viscous_tangential_coefficient_n_s_per_m(r, b.viscosity_pa_s, bond.gap_m, self.min_gap_m);
+                    let coefficient = if bond.gap_m <= self.min_gap_m && r == at_contact.effective_radius_m {
+                        at_contact.viscous_tangential_n_s_per_m
+                    } else {
+                        viscous_tangential_coefficient_n_s_per_m(r, b.viscosity_pa_s, bond.gap_m, self.min_gap_m)
+                    };
                     let v = bond.contact_velocity;
                     let tangential_velocity = v - bond.normal * v.dot(&bond.normal);
                     tangential_n = -tangential_velocity * coefficient;
@@ -466,18 +489,56 @@ impl Cohesion {
         }
     }
 
+    /// The capillary force of a bridge of `volume_m3` across `gap_m` (Mikami's fit or the pair's Young–Laplace
+    /// table, as `bridge` says), N.
+    #[inline]
+    fn capillary_force_n(
+        &self,
+        bridge: &BridgeConstants,
+        volume_m3: f64,
+        gap_m: f64,
+        surface_tension_n_per_m: f64,
+    ) -> f64 {
+        match bridge.table {
+            Some(t) => self.tables[t as usize].force_n(volume_m3, gap_m, surface_tension_n_per_m),
+            None => bridge.mikami.force_n(gap_m),
+        }
+    }
+
+    /// `constants` completed with its forces at contact ([`BridgeAtContact`]) for effective radius `r_star_m`.
+    fn with_contact_forces(
+        &self,
+        mut constants: BridgeConstants,
+        r_star_m: f64,
+        bridge: LiquidBridge,
+    ) -> BridgeConstants {
+        constants.at_contact = BridgeAtContact {
+            effective_radius_m: r_star_m,
+            capillary_n: self.capillary_force_n(&constants, constants.volume_m3, 0.0, bridge.surface_tension_n_per_m),
+            viscous_tangential_n_s_per_m: viscous_tangential_coefficient_n_s_per_m(
+                r_star_m,
+                bridge.viscosity_pa_s,
+                self.min_gap_m,
+                self.min_gap_m,
+            ),
+        };
+        constants
+    }
+
     /// The constants of a bridge of `volume_m3` between particle species `a` and `b` (effective radius `r_star_m`).
     pub fn pair_bridge(&self, a: SpeciesId, b: SpeciesId, r_star_m: f64, volume_m3: f64) -> BridgeConstants {
         let CohesionModel::LiquidBridge(bridge) = self.model else {
             return BridgeConstants::NONE;
         };
         let (ti, tj) = (self.contact_angle_rad[a.index()], self.contact_angle_rad[b.index()]);
-        BridgeConstants {
+        let constants = BridgeConstants {
             volume_m3,
             mikami: MikamiBridge::new(r_star_m, volume_m3, 0.5 * (ti + tj), bridge.surface_tension_n_per_m),
             table: self.pair_tables[self.pair_index(a, b)],
             rupture_gap_m: lian_rupture_gap_m(volume_m3, ti, tj).min(self.range_m),
-        }
+            at_contact: BridgeConstants::NONE.at_contact,
+        };
+        self.with_contact_forces(constants, r_star_m, bridge)
     }
 
     /// The constants of a bridge of `volume_m3` between a particle of species `a` and radius `radius_m` and a wall of
@@ -487,12 +548,14 @@ impl Cohesion {
             return BridgeConstants::NONE;
         };
         let (ti, tw) = (self.contact_angle_rad[a.index()], self.contact_angle_rad[wall.index()]);
-        BridgeConstants {
+        let constants = BridgeConstants {
             volume_m3,
             mikami: MikamiBridge::new(radius_m, volume_m3, 0.5 * (ti + tw), bridge.surface_tension_n_per_m),
             table: self.wall_tables[a.index() * self.n_species + wall.index()],
             rupture_gap_m: lian_rupture_gap_m(volume_m3, ti, tw).min(self.wall_range_m),
-        }
+            at_contact: BridgeConstants::NONE.at_contact,
+        };
+        self.with_contact_forces(constants, radius_m, bridge)
     }
 }
 

@@ -442,9 +442,10 @@ impl<'a> Context<'a> {
             if dist2 >= range * range && cohesion_state(hist, k).is_empty() {
                 return None;
             }
-            let bond = self.pair_bond(c, bi, j, vel, d, dist2, reach, hist, k, slot, crossings);
+            let dist = dist2.sqrt();
+            let bond = self.pair_bond(c, bi, j, vel, d, dist, reach, hist, k, slot, crossings);
             if P::HEAT {
-                flows.heat_flow_w += self.bridge_heat_flow_w(i, bi, j, vel, hist, k, dist2.sqrt() - reach);
+                flows.heat_flow_w += self.bridge_heat_flow_w(i, bi, j, vel, hist, k, dist - reach);
             }
             return Some(bond);
         }
@@ -496,7 +497,7 @@ impl<'a> Context<'a> {
             None => Some(contact),
             Some(c) if c.inert_without_bridge(hist.cohesion.bridge_volume_m3[k]) => Some(contact),
             Some(c) => {
-                let bond = self.pair_bond(c, bi, j, vel, d, dist2, reach, hist, k, slot, crossings);
+                let bond = self.pair_bond(c, bi, j, vel, d, dist, reach, hist, k, slot, crossings);
                 if P::HEAT {
                     flows.heat_flow_w += self.bridge_heat_flow_w(i, bi, j, vel, hist, k, dist - reach);
                 }
@@ -545,7 +546,7 @@ impl<'a> Context<'a> {
         j: usize,
         vel: &impl Motion,
         d: Vec3,
-        dist2: f64,
+        dist: f64,
         reach: f64,
         hist: &mut ColumnsMut,
         k: usize,
@@ -554,7 +555,6 @@ impl<'a> Context<'a> {
     ) -> PairResult {
         let (ri, rj) = (bi.radius_m, self.radius_m[j]);
         let (mi, mj) = (bi.mass_kg, self.mass_kg[j]);
-        let dist = dist2.sqrt();
         let normal = d / dist;
         let u = bi.v - vel.v(j);
         let bond = Bond {
