@@ -50,15 +50,17 @@ fn wrap_or_clamp(grid: &Grid, axis: usize, i: isize) -> usize {
     }
 }
 
-/// The cells a sphere overlaps along one axis with the fraction of its volume in each (at most a few entries).
-fn axis_split(grid: &Grid, axis: usize, centre: f64, radius: f64) -> Vec<(usize, f64)> {
+/// The cells a sphere overlaps along one axis with the fraction of its volume in each (at most a few entries), into
+/// `out` (cleared first: one buffer serves every particle of a porosity pass).
+fn axis_split(grid: &Grid, axis: usize, centre: f64, radius: f64, out: &mut Vec<(usize, f64)>) {
+    out.clear();
     if grid.n[axis] == 1 && !grid.periodic(axis) {
-        return vec![(0, 1.0)];
+        out.push((0, 1.0));
+        return;
     }
     let h = grid.h_m[axis];
     let first = cell_along(grid, axis, centre - radius);
     let last = cell_along(grid, axis, centre + radius);
-    let mut out: Vec<(usize, f64)> = Vec::with_capacity((last - first + 1) as usize);
     let mut below_previous = 0.0;
     for i in first..=last {
         let top = grid.origin_m[axis] + (i + 1) as f64 * h;
@@ -75,12 +77,12 @@ fn axis_split(grid: &Grid, axis: usize, centre: f64, radius: f64) -> Vec<(usize,
             None => out.push((cell, fraction)),
         }
     }
-    out
 }
 
 /// Solid volume in each cell, m³.
 pub fn solid_volume_m3(grid: &Grid, method: PorosityMethod, positions_m: &[Vec3], radii_m: &[f64]) -> Vec<f64> {
     let mut solid = vec![0.0; grid.cells()];
+    let mut splits: [Vec<(usize, f64)>; 3] = Default::default();
     for (x, &r) in positions_m.iter().zip(radii_m) {
         let volume = 4.0 / 3.0 * std::f64::consts::PI * r * r * r;
         match method {
@@ -89,7 +91,9 @@ pub fn solid_volume_m3(grid: &Grid, method: PorosityMethod, positions_m: &[Vec3]
                 solid[grid.cell(idx)] += volume;
             }
             PorosityMethod::VolumeSplit => {
-                let splits: [Vec<(usize, f64)>; 3] = std::array::from_fn(|a| axis_split(grid, a, x[a], r));
+                for (a, split) in splits.iter_mut().enumerate() {
+                    axis_split(grid, a, x[a], r, split);
+                }
                 for &(i, fx) in &splits[0] {
                     for &(j, fy) in &splits[1] {
                         for &(k, fz) in &splits[2] {
