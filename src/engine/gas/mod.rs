@@ -2,6 +2,7 @@
 //! its sparse linear solvers. Coupling to the particles (porosity, drag, two-way momentum exchange) builds on it, and
 //! scalars the gas carries (temperature, vapour) are transported with its flow and exchanged with the particles.
 
+pub(crate) mod boundary_velocities;
 pub mod coupled;
 pub mod coupling;
 pub mod exchange;

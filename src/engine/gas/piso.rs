@@ -4,7 +4,8 @@
 
 use serde::{Deserialize, Serialize};
 
-use super::simple::{GasSolver, Outlets, StepReport};
+use super::boundary_velocities::Outlets;
+use super::simple::{GasSolver, StepReport};
 
 /// How a gas step couples pressure and velocity.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize, schemars::JsonSchema)]
