@@ -419,7 +419,7 @@ impl Cohesion {
     /// square-well state. `bridge`: the constants of the slot's liquid bridge (for its current volume). `dt_s` turns
     /// the square well's crossing impulse into a force acting for one step (the two half kicks of velocity Verlet
     /// deliver exactly F dt).
-    #[inline]
+    #[inline(always)]
     pub fn force(&self, bond: &Bond, state: &mut CohesionHistory, bridge: &BridgeConstants, dt_s: f64) -> BondForce {
         match self.model {
             CohesionModel::LiquidBridge(b) => {

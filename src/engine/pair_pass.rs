@@ -538,7 +538,7 @@ impl<'a> Context<'a> {
     /// The cohesion force of the pair (i, j) in local slot `k`, with the pair's geometry formed as seed 000 and
     /// seed 001 write it (n = d/|d|, R* = R_i R_j/(R_i + R_j), μ = m_i m_j/(m_i + m_j)).
     #[allow(clippy::too_many_arguments)]
-    #[inline(never)]
+    #[inline(always)]
     fn pair_bond(
         &self,
         c: &Cohesion,
