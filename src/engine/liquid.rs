@@ -100,6 +100,13 @@ pub fn step_liquid(
     events
 }
 
+/// Relative margin on a squared centre distance within which [`exchange_bridges`] takes the square root to decide
+/// whether a pair touches or its bridge has ruptured. Outside it the squared comparison gives the same answer as the
+/// rounded gap: the products' rounding is below 1e-15 relative, and the square root and the subtraction round
+/// monotonically towards a threshold that is itself a double. (The decisions, hence the bits, are those of the gap
+/// taken for every pair in range.)
+const SQUARED_DECISION_MARGIN: f64 = 1e-12;
+
 /// Bridge formation and rupture over every pair and wall slot, serially in index order.
 fn exchange_bridges(
     cohesion: &Cohesion,
@@ -137,8 +144,13 @@ fn exchange_bridges(
             if dist2 >= range * range && volume == 0.0 {
                 continue;
             }
-            let gap = dist2.sqrt() - reach;
-            if volume == 0.0 && gap < 0.0 {
+            // The surface gap (a square root) is needed only near the thresholds: touching for a pair without a
+            // bridge, the rupture gap for one with. Elsewhere the squared distance, with a margin far above its
+            // rounding, decides the same way ([`SQUARED_DECISION_MARGIN`]).
+            if volume == 0.0 && dist2 > reach * reach * (1.0 + SQUARED_DECISION_MARGIN) {
+                continue;
+            }
+            if volume == 0.0 && dist2.sqrt() - reach < 0.0 {
                 let (from_i, from_j) = bridge_volume_on_contact_m3(p.liquid_m3[i], ri, p.liquid_m3[j], rj);
                 if from_i + from_j > 0.0 {
                     p.liquid_m3[i] -= from_i;
@@ -151,7 +163,11 @@ fn exchange_bridges(
             if volume > 0.0 && constants.volume_m3 != volume {
                 *constants = cohesion.pair_bridge(si, sj, ri * rj / reach, volume);
             }
-            if volume > 0.0 && gap > constants.rupture_gap_m {
+            let rupture_distance_m = reach + constants.rupture_gap_m;
+            if volume > 0.0
+                && dist2 >= rupture_distance_m * rupture_distance_m * (1.0 - SQUARED_DECISION_MARGIN)
+                && dist2.sqrt() - reach > constants.rupture_gap_m
+            {
                 let kept_by_i = cohesion.rupture_share_of_i(si, sj, volume) * volume;
                 p.liquid_m3[i] += kept_by_i;
                 p.liquid_m3[j] += volume - kept_by_i;
