@@ -99,6 +99,7 @@ fn norm(a: &[f64]) -> f64 {
 
 /// A stencil system compacted for the iterations: the off-diagonal entries of each row as (column, −a_nb), the
 /// rows' lower (column < row) entries first, without the absent neighbours (compressed sparse rows).
+#[derive(Debug, Clone, Default)]
 struct CompactRows {
     diagonal: Vec<f64>,
     /// Row p's entries are `start[p]..start[p + 1]`; the first `lower_end[p] − start[p]` of them are below the
@@ -107,18 +108,39 @@ struct CompactRows {
     lower_end: Vec<u32>,
     column: Vec<u32>,
     value: Vec<f64>,
+    /// Where each entry's −a_nb comes from: `anb[p][k]` at `p · NEIGHBOURS + k` (flattened).
+    source: Vec<u32>,
+    /// The stencil's neighbours the structure above was built from: a system with the same ones (a momentum
+    /// component's, every outer iteration of every gas step) only refills the values.
+    built_from: Vec<[u32; NEIGHBOURS]>,
 }
 
 impl CompactRows {
     fn new(sys: &StencilSystem) -> Self {
+        let mut rows = CompactRows::default();
+        rows.fill(sys);
+        rows
+    }
+
+    /// Becomes the compacted form of `sys`, reusing its storage.
+    fn fill(&mut self, sys: &StencilSystem) {
         let n = sys.len();
-        let mut rows = CompactRows {
-            diagonal: sys.ap.clone(),
-            start: Vec::with_capacity(n + 1),
-            lower_end: Vec::with_capacity(n),
-            column: Vec::with_capacity(4 * n),
-            value: Vec::with_capacity(4 * n),
-        };
+        let rows = self;
+        rows.diagonal.clear();
+        rows.diagonal.extend_from_slice(&sys.ap);
+        if rows.built_from == sys.nb {
+            let anb = sys.anb.as_flattened();
+            for (v, &from) in rows.value.iter_mut().zip(&rows.source) {
+                *v = -anb[from as usize];
+            }
+            return;
+        }
+        rows.built_from.clone_from(&sys.nb);
+        rows.source.clear();
+        rows.start.clear();
+        rows.lower_end.clear();
+        rows.column.clear();
+        rows.value.clear();
         rows.start.push(0);
         for p in 0..n {
             for lower in [true, false] {
@@ -127,6 +149,7 @@ impl CompactRows {
                     if q != NONE && ((q as usize) < p) == lower {
                         rows.column.push(q);
                         rows.value.push(-sys.anb[p][k]);
+                        rows.source.push((p * NEIGHBOURS + k) as u32);
                     }
                 }
                 if lower {
@@ -135,7 +158,6 @@ impl CompactRows {
             }
             rows.start.push(rows.column.len() as u32);
         }
-        rows
     }
 
     /// y = A x.
@@ -155,6 +177,29 @@ impl CompactRows {
         for (ri, bi) in r.iter_mut().zip(b) {
             *ri = bi - *ri;
         }
+    }
+}
+
+/// What a Krylov solve keeps from one system to the next: the compacted rows and the iteration vectors, so that the
+/// many small solves of a gas step allocate nothing once the first has sized them. It carries no information
+/// between solves (each overwrites or zeroes what it reads), so a solve gives the same bits with a fresh workspace
+/// or a used one.
+#[derive(Debug, Clone, Default)]
+pub struct KrylovWorkspace {
+    rows: CompactRows,
+    vectors: [Vec<f64>; 9],
+}
+
+impl KrylovWorkspace {
+    /// The compacted `sys` and nine zeroed vectors of its length.
+    fn prepare(&mut self, sys: &StencilSystem) -> (&CompactRows, &mut [Vec<f64>; 9]) {
+        self.rows.fill(sys);
+        let n = sys.len();
+        for v in &mut self.vectors {
+            v.clear();
+            v.resize(n, 0.0);
+        }
+        (&self.rows, &mut self.vectors)
     }
 }
 
@@ -456,26 +501,32 @@ fn eliminate_band_body(l: &mut [f64], ap: &[f64], n: usize, bw: usize) {
 /// Jacobi-preconditioned BiCGStab (van der Vorst 1992) for a non-symmetric system; `x` holds the start and the
 /// result.
 pub fn bicgstab(sys: &StencilSystem, x: &mut [f64], tolerance: f64, max_iterations: usize) -> SolveReport {
+    bicgstab_in(&mut KrylovWorkspace::default(), sys, x, tolerance, max_iterations)
+}
+
+/// [`bicgstab`] in the storage of `workspace`.
+pub fn bicgstab_in(
+    workspace: &mut KrylovWorkspace,
+    sys: &StencilSystem,
+    x: &mut [f64],
+    tolerance: f64,
+    max_iterations: usize,
+) -> SolveReport {
     let n = sys.len();
     let Some(b_norm) = right_hand_side_norm(sys, x) else {
         return SolveReport::ZERO_RIGHT_HAND_SIDE;
     };
-    let rows = CompactRows::new(sys);
-    let inv_diag: Vec<f64> = sys.ap.iter().map(|a| if *a != 0.0 { 1.0 / a } else { 1.0 }).collect();
-    let mut r = vec![0.0; n];
-    rows.residual(&sys.b, x, &mut r);
-    let r_hat = r.clone();
+    let (rows, [inv_diag, r, r_hat, v, p, y, s, z, t]) = workspace.prepare(sys);
+    for (d, a) in inv_diag.iter_mut().zip(&sys.ap) {
+        *d = if *a != 0.0 { 1.0 / a } else { 1.0 };
+    }
+    rows.residual(&sys.b, x, r);
+    r_hat.copy_from_slice(r);
     let (mut rho, mut alpha, mut omega) = (1.0, 1.0, 1.0);
-    let mut v = vec![0.0; n];
-    let mut p = vec![0.0; n];
-    let mut y = vec![0.0; n];
-    let mut s = vec![0.0; n];
-    let mut z = vec![0.0; n];
-    let mut t = vec![0.0; n];
     let mut iterations = 0;
-    let mut rel = norm(&r) / b_norm;
+    let mut rel = norm(r) / b_norm;
     while rel > tolerance && iterations < max_iterations {
-        let rho_new = dot(&r_hat, &r);
+        let rho_new = dot(r_hat, r);
         if rho_new == 0.0 || omega == 0.0 {
             break;
         }
@@ -485,8 +536,8 @@ pub fn bicgstab(sys: &StencilSystem, x: &mut [f64], tolerance: f64, max_iteratio
             p[i] = r[i] + beta * (p[i] - omega * v[i]);
             y[i] = p[i] * inv_diag[i];
         }
-        rows.apply(&y, &mut v);
-        let rv = dot(&r_hat, &v);
+        rows.apply(y, v);
+        let rv = dot(r_hat, v);
         if rv == 0.0 {
             break;
         }
@@ -494,31 +545,31 @@ pub fn bicgstab(sys: &StencilSystem, x: &mut [f64], tolerance: f64, max_iteratio
         for i in 0..n {
             s[i] = r[i] - alpha * v[i];
         }
-        if norm(&s) / b_norm <= tolerance {
+        if norm(s) / b_norm <= tolerance {
             for i in 0..n {
                 x[i] += alpha * y[i];
             }
-            r.copy_from_slice(&s);
+            r.copy_from_slice(s);
             iterations += 1;
             break;
         }
         for i in 0..n {
             z[i] = s[i] * inv_diag[i];
         }
-        rows.apply(&z, &mut t);
-        let tt = dot(&t, &t);
-        omega = if tt > 0.0 { dot(&t, &s) / tt } else { 0.0 };
+        rows.apply(z, t);
+        let tt = dot(t, t);
+        omega = if tt > 0.0 { dot(t, s) / tt } else { 0.0 };
         for i in 0..n {
             x[i] += alpha * y[i] + omega * z[i];
             r[i] = s[i] - omega * t[i];
         }
         iterations += 1;
-        rel = norm(&r) / b_norm;
+        rel = norm(r) / b_norm;
     }
     // The recursively updated residual drifts from the true one: report the true one, and call it converged
     // within a factor 10 of the tolerance (the size of that drift).
-    rows.residual(&sys.b, x, &mut r);
-    rel = norm(&r) / b_norm;
+    rows.residual(&sys.b, x, r);
+    rel = norm(r) / b_norm;
     SolveReport {
         iterations,
         relative_residual: rel,

@@ -18,8 +18,8 @@ use serde::{Deserialize, Serialize};
 use super::boundary_velocities::Outlets;
 use super::grid::{Boundary, Grid, side};
 use super::linsolve::{
-    NEIGHBOURS, NONE, PressureSolver, SolveReport, StencilSystem, bandwidth, bicgstab, conjugate_gradient,
-    direct_symmetric,
+    KrylovWorkspace, NEIGHBOURS, NONE, PressureSolver, SolveReport, StencilSystem, bandwidth, bicgstab_in,
+    conjugate_gradient, direct_symmetric,
 };
 use super::momentum_rows::{Across, MomentumRow, NeighbourFace, momentum_rows};
 use super::piso::PressureVelocity;
@@ -246,6 +246,9 @@ pub struct GasSolver {
     rows: [Vec<MomentumRow>; 3],
     /// Per cell (in cell order), its faces along each axis, low side first: see [`PressureSide`].
     pressure_sides: Vec<PressureSide>,
+    /// Per component: its momentum solves' storage, reused from one solve to the next (no state: see
+    /// [`KrylovWorkspace`]; one per component, whose stencils differ, so that each keeps its compacted structure).
+    krylov: [KrylovWorkspace; 3],
 }
 
 impl GasSolver {
@@ -322,6 +325,7 @@ impl GasSolver {
             plenum,
             inflow_factor: 1.0,
             rows,
+            krylov: Default::default(),
         };
         solver.inflow_factor = solver.inflow_factor_at(solver.state.time_s);
         solver.apply_boundary_velocities();
@@ -636,7 +640,8 @@ impl GasSolver {
                 .map(|&f| self.state.velocity_m_per_s[c][f])
                 .collect();
             let t = std::time::Instant::now();
-            let r = bicgstab(
+            let r = bicgstab_in(
+                &mut self.krylov[c],
                 &sys,
                 &mut x,
                 self.config.linear_tolerance,
