@@ -181,9 +181,10 @@ impl CompactRows {
 }
 
 /// What a Krylov solve keeps from one system to the next: the compacted rows and the iteration vectors, so that the
-/// many small solves of a gas step allocate nothing once the first has sized them. It carries no information
-/// between solves (each overwrites or zeroes what it reads), so a solve gives the same bits with a fresh workspace
-/// or a used one.
+/// many small solves of a gas step allocate nothing once the first has sized them. What it keeps between solves is
+/// the rows' structure, reused only for a system with the same neighbours (whose compaction would be the same), and
+/// vectors that each solve zeroes or overwrites before reading: a solve gives the same bits with a fresh workspace or
+/// a used one.
 #[derive(Debug, Clone, Default)]
 pub struct KrylovWorkspace {
     rows: CompactRows,
