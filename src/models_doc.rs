@@ -97,7 +97,12 @@ heat (optional: particle temperatures and conduction, seed 000 chapter 5):
                                                                          (E*_sim/E*_real)^(1/5)
   gas?: { conductivity_w_per_m_k?, heat_capacity_j_per_kg_k?, nusselt?,  with a gas: eq. 5.8 on the grid and
           initial_temperature_k?, inlet_temperature_k?,                  Q_f = h_gp S_p (T_gas - T_p), eq. 5.5;
-          jet_temperatures_k? }                                          defaults: Table 7's air
+          jet_temperatures_k?, lens_conduction? }                        defaults: Table 7's air
+    lens_conduction: { lens_radius_fraction?, min_gap_m? }               gas between nearly touching surfaces,
+                                                                         H = k_g ∫ 2πr dr/max(gap, s) over a lens
+                                                                         of (1+f)R (Rong & Horio 1999, MFIX's
+                                                                         PFP; defaults f 0.2, s 4e-10 m); pairs
+                                                                         and heated walls; off by default
     nusselt: seed000: { coefficient? } (default, 1.8)                    eqs. 5.6-5.7
              ranz_marshall                                               Nu = 2 + 0.6 Re^1/2 Pr^1/3
              gunn                                                        Gunn (1978), beds

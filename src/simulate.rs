@@ -72,6 +72,11 @@ pub struct BiotNumbers {
     pub contact_max: f64,
     /// The largest h_gp R / k_s over the particles (eq. 5.13); 0 without a gas.
     pub convection_max: f64,
+    /// The largest H R/(k_s π R²) of the gas lens (`heat.gas.lens_conduction`) over touching pairs and wall
+    /// contacts, eq. 5.15's form with the lens's conductance (R the smaller radius); 0 without the lens. The lens
+    /// puts its heat near the contact point: where this is not ≪ 1 (glass in air at the wall, about 0.4) the lumped
+    /// temperature is an approximation.
+    pub lens_max: f64,
 }
 
 /// The [`BiotNumbers`] of the current state, `None` without heat transfer.
@@ -98,6 +103,35 @@ pub fn biot_numbers(sim: &Simulation) -> Option<BiotNumbers> {
         biot(p.radius_m[i] - gap, p.radius_m[i])
     });
     let contact_max = pairs.chain(walls).fold(0.0, f64::max);
+    let lens = sim.config.heat.as_ref().and_then(|h| h.lens);
+    let k_s = |i: usize| sim.config.species.get(p.species[i]).thermal_conductivity_w_per_m_k;
+    let lens_max = lens.map_or(0.0, |lens| {
+        let pairs = contacts
+            .pairs
+            .iter()
+            .filter(|(_, _, h)| h.active)
+            .filter_map(|(i, j, _)| {
+                let (i, j) = (i.index(), j.index());
+                let separation = sim.config.domain.separation(&p.position_m[i], &p.position_m[j]).norm();
+                let h = lens.pair_conductance_w_per_k(p.radius_m[i], p.radius_m[j], separation);
+                let r = p.radius_m[i].min(p.radius_m[j]);
+                Some(h / (std::f64::consts::PI * r * k_s(i)?.min(k_s(j)?)))
+            });
+        let walls = contacts
+            .walls
+            .iter()
+            .filter(|(_, _, h)| h.active)
+            .filter_map(|(i, w, _)| {
+                let (i, w) = (i.index(), w.0 as usize);
+                let gap = sim.config.walls[w]
+                    .proximity(&p.position_m[i], sim.wall_angle_rad[w])
+                    .gap_m
+                    - p.radius_m[i];
+                let h = lens.wall_conductance_w_per_k(p.radius_m[i], gap);
+                Some(h / (std::f64::consts::PI * p.radius_m[i] * k_s(i)?))
+            });
+        pairs.chain(walls).fold(0.0, f64::max)
+    });
     let convection_max = sim.gas.as_ref().map_or(0.0, |gas| {
         (0..p.len())
             .filter_map(|i| {
@@ -113,6 +147,7 @@ pub fn biot_numbers(sim: &Simulation) -> Option<BiotNumbers> {
     Some(BiotNumbers {
         contact_max,
         convection_max,
+        lens_max,
     })
 }
 

@@ -358,6 +358,21 @@ const HEAT_CASES: &[(&str, &str, &str, &[&str])] = &[
         ],
     ),
     (
+        "a gas lens of negative size",
+        "  walls: { box_z_lo: { temperature_k: 400.0 } }",
+        "  walls: { box_z_lo: { temperature_k: 400.0 } }\n  gas: { lens_conduction: { lens_radius_fraction: -0.2 } }",
+        &[
+            "heat.gas.lens_conduction.lens_radius_fraction",
+            "expected a finite value > 0, got -0.2",
+        ],
+    ),
+    (
+        "a gas lens whose smallest gap is a particle's size",
+        "  walls: { box_z_lo: { temperature_k: 400.0 } }",
+        "  walls: { box_z_lo: { temperature_k: 400.0 } }\n  gas: { lens_conduction: { min_gap_m: 0.01 } }",
+        &["heat.gas.lens_conduction.min_gap_m", "expected a gap well below the particles' radius"],
+    ),
+    (
         "a liquid that does not conduct",
         "  walls: { box_z_lo: { temperature_k: 400.0 } }",
         "  walls: { box_z_lo: { temperature_k: 400.0 } }\n  liquid_conductivity_w_per_m_k: 0.0",

@@ -67,11 +67,16 @@ impl SimConfig {
         }
     }
 
-    /// How far beyond contact the neighbour list must reach for the cohesion model.
+    /// How far beyond contact the neighbour list must reach for the cohesion model and the gas lens's conduction.
     pub fn reach(&self) -> Reach {
-        self.cohesion.as_ref().map_or(Reach::default(), |c| Reach {
+        let cohesion = self.cohesion.as_ref().map_or(Reach::default(), |c| Reach {
             pair_gap_m: c.range_m,
             wall_gap_m: c.wall_range_m,
-        })
+        });
+        let lens = self.heat.as_ref().map_or(0.0, |h| h.lens_reach_m);
+        Reach {
+            pair_gap_m: cohesion.pair_gap_m.max(lens),
+            wall_gap_m: cohesion.wall_gap_m.max(lens),
+        }
     }
 }

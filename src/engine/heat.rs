@@ -2,7 +2,8 @@
 //! contact, and what the particles' temperature update needs.
 //!
 //! Each particle is lumped (one temperature; valid for Biot ≪ 1, §5.1.3) and its energy follows
-//! m c_p dT/dt = Σ Q_c (eq. 5.2): the pair pass sums the conduction through its contacts and walls into the
+//! m c_p dT/dt = Σ Q_c (eq. 5.2), Q_c through the solid contact, a liquid bridge and, where the run has it, the gas
+//! lens round a contact or narrow gap (`models::gas_lens`): the pair pass sums the conduction through its contacts and walls into the
 //! `heat_flow_w` channel (`channels.rs`) in its fixed order, and as soon as a particle's sum is complete the pass
 //! advances its temperature by one explicit step, T += dt Q/(m c_p). Every pair's heat leaves one particle as it
 //! enters the other, so the particles' total energy Σ m c_p T changes only by what the walls give, to rounding.
@@ -12,6 +13,7 @@
 use super::models::PairTable;
 use super::models::bridge_conduction::{BridgeLengthTable, bridge_conductance_w_per_k};
 use super::models::conduction::{ThermalPair, effective_modulus_pa};
+use super::models::gas_lens::GasLens;
 use super::particles::{Particles, SpeciesId, SpeciesTable};
 
 /// Everything heat transfer needs that does not change during a run.
@@ -28,6 +30,10 @@ pub struct HeatConfig {
     pub wall_heated_from_s: Vec<f64>,
     /// Conduction through liquid bridges (a run with liquid bridges).
     pub bridges: Option<BridgeConduction>,
+    /// Conduction through the gas between nearly touching surfaces (`heat.gas.lens_conduction`, a run with gas).
+    pub lens: Option<GasLens>,
+    /// How far beyond contact the lens reaches (f R_b of the largest particle), m; 0 without the lens.
+    pub lens_reach_m: f64,
 }
 
 /// Conduction through liquid bridges (seed 000 eqs 7.8–7.11), H_l = k_l V/d²: the liquid's conductivity and the
@@ -160,7 +166,16 @@ impl HeatConfig {
             wall_temperature_k,
             wall_heated_from_s,
             bridges: None,
+            lens: None,
+            lens_reach_m: 0.0,
         }
+    }
+
+    /// Conducts through the gas lens `lens` between particles of radii up to `largest_radius_m` and walls.
+    pub fn with_lens(mut self, lens: GasLens, largest_radius_m: f64) -> HeatConfig {
+        self.lens_reach_m = lens.reach_m(largest_radius_m);
+        self.lens = Some(lens);
+        self
     }
 
     /// Each wall's temperature at time `time_s` (`None`: adiabatic then), into `out`.
@@ -210,6 +225,8 @@ impl HeatConfig {
             .bridges
             .as_ref()
             .map_or(0.0, |b| b.largest_conductance_per_radius_w_per_m_k() * largest_radius);
-        13.0 * (largest_pair * contact_radius + largest_bridge) * 2.0 * largest_inverse
+        // And the gas lens.
+        let largest_lens = self.lens.map_or(0.0, |l| l.largest_conductance_w_per_k(largest_radius));
+        13.0 * (largest_pair * contact_radius + largest_bridge + largest_lens) * 2.0 * largest_inverse
     }
 }

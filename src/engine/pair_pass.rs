@@ -433,6 +433,15 @@ impl<'a> Context<'a> {
                 *flows = ended;
             }
             hist.release_as::<P>(k);
+            if P::HEAT
+                && let Some(lens) = self.heat.and_then(|h| h.lens.as_ref())
+            {
+                // Apart, the gas between the surfaces still conducts while the lens reaches across.
+                let lens_reach = reach + lens.reach_m(if ri > rj { ri } else { rj });
+                if dist2 < lens_reach * lens_reach {
+                    flows.heat_flow_w += lens.pair_conductance_w_per_k(ri, rj, dist2.sqrt()) * (vel.t(j) - vel.t(i));
+                }
+            }
             // Apart: the cohesion model alone, while in range or carrying a bridge or well.
             let c = cohesion?;
             if c.inert_without_bridge(hist.cohesion.bridge_volume_m3[k]) {
@@ -479,12 +488,16 @@ impl<'a> Context<'a> {
         if P::HEAT
             && let Some(heat) = self.heat
         {
-            // Q = H (T_j − T_i) into i (seed 000 eq. 5.3); j receives the opposite.
-            let conductance = heat.pair(bi.species, self.species[j]).conductance_w_per_k(
+            // Q = H (T_j − T_i) into i (seed 000 eq. 5.3); j receives the opposite. With the gas lens, the gas
+            // round the contact conducts beside it.
+            let mut conductance = heat.pair(bi.species, self.species[j]).conductance_w_per_k(
                 &self.law.normal,
                 &out,
                 kin.effective_radius_m,
             );
+            if let Some(lens) = &heat.lens {
+                conductance += lens.pair_conductance_w_per_k(ri, rj, dist);
+            }
             flows.heat_flow_w = conductance * (vel.t(j) - vel.t(i));
         }
         let nxft = n.cross(&out.tangential_force);
@@ -507,6 +520,19 @@ impl<'a> Context<'a> {
                     torque_j: contact.torque_j + bond.torque_j,
                 })
             }
+        }
+    }
+
+    /// Conduction through the gas lens between particle i (temperature `ti`) and wall `w` at surface gap `gap_m`
+    /// (negative in overlap), if the run has the lens and the wall is heated: H (T_w − T_i) into i, W.
+    #[inline(always)]
+    fn wall_lens_heat_flow_w(&self, i: usize, w: u16, gap_m: f64, ti: f64) -> f64 {
+        if let Some(lens) = self.heat.and_then(|h| h.lens.as_ref())
+            && let Some(wall_temperature_k) = self.wall_temperature_k[w as usize]
+        {
+            lens.wall_conductance_w_per_k(self.radius_m[i], gap_m) * (wall_temperature_k - ti)
+        } else {
+            0.0
         }
     }
 
@@ -616,6 +642,9 @@ impl<'a> Context<'a> {
                 let overlap = ri - prox.gap_m;
                 if overlap <= 0.0 {
                     hist.release_as::<P>(k);
+                    if P::HEAT {
+                        heat_flow_w += self.wall_lens_heat_flow_w(i, w, -overlap, ti);
+                    }
                     continue;
                 }
                 worst.note(overlap, ri, i, u32::MAX - w as u32);
@@ -644,6 +673,7 @@ impl<'a> Context<'a> {
                         heat.pair(self.species[i], wall.species)
                             .conductance_w_per_k(&self.law.normal, &out, ri);
                     heat_flow_w += conductance * (wall_temperature_k - ti);
+                    heat_flow_w += self.wall_lens_heat_flow_w(i, w, -overlap, ti);
                 }
             }
             return ScalarFlows {
@@ -716,6 +746,9 @@ impl<'a> Context<'a> {
                 flows = ended;
             }
             hist.release_as::<P>(k);
+            if P::HEAT {
+                flows.heat_flow_w += self.wall_lens_heat_flow_w(i, w, -overlap, ti);
+            }
             None
         } else {
             worst.note(overlap, ri, i, u32::MAX - w as u32);
@@ -744,6 +777,7 @@ impl<'a> Context<'a> {
                     heat.pair(self.species[i], wall.species)
                         .conductance_w_per_k(&self.law.normal, &out, ri);
                 flows.heat_flow_w = conductance * (wall_temperature_k - ti);
+                flows.heat_flow_w += self.wall_lens_heat_flow_w(i, w, -overlap, ti);
             }
             Some((out.force, -(n.cross(&out.tangential_force) * ri) + out.rolling_torque))
         };

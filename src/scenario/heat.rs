@@ -11,6 +11,7 @@ use crate::engine::geometry::Wall;
 use crate::engine::heat::{BridgeConduction, HeatConfig};
 use crate::engine::models::PairTable;
 use crate::engine::models::cohesion_law::CohesionModel;
+use crate::engine::models::gas_lens::GasLens;
 use crate::engine::particles::{Particles, SpeciesTable};
 
 /// The run's heat configuration, with `particles.temperature_k` set from the fills (`fill_ends[k]`: one past the
@@ -186,6 +187,40 @@ pub(super) fn build_heat(
             BridgeConduction::new(species, &particle_species, &wall_species, k_l)
                 .map_err(|m| fail("cohesion.liquid_bridge".into(), m))?,
         );
+    }
+    if let Some(lens) = g.lens_conduction {
+        for (key, value) in [
+            ("lens_radius_fraction", lens.lens_radius_fraction),
+            ("min_gap_m", lens.min_gap_m),
+        ] {
+            if !(value.is_finite() && value > 0.0) {
+                return Err(fail(
+                    format!("heat.gas.lens_conduction.{key}"),
+                    format!("expected a finite value > 0, got {value}"),
+                ));
+            }
+        }
+        if lens.min_gap_m >= particles.max_radius_m().max(f64::MIN_POSITIVE) {
+            return Err(fail(
+                "heat.gas.lens_conduction.min_gap_m".into(),
+                format!(
+                    "expected a gap well below the particles' radius ({} m), got {} m",
+                    particles.max_radius_m(),
+                    lens.min_gap_m
+                ),
+            ));
+        }
+        // The lens is gas: without one (no `gas`, or `gas.vacuum`) there is nothing to conduct through.
+        if spec.gas.as_ref().is_some_and(|gas| !gas.vacuum) {
+            config = config.with_lens(
+                GasLens {
+                    gas_conductivity_w_per_m_k: g.conductivity_w_per_m_k,
+                    lens_radius_fraction: lens.lens_radius_fraction,
+                    min_gap_m: lens.min_gap_m,
+                },
+                particles.max_radius_m(),
+            );
+        }
     }
     let rate_per_s = config.fastest_relaxation_per_s(particles, spec.max_overlap_fraction);
     if dt_s * rate_per_s >= 1.0 {

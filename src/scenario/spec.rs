@@ -222,6 +222,31 @@ pub struct GasHeatSpec {
     /// Each jet's own inlet temperature, K, in the order of `gas.jets` (default: `inlet_temperature_k`).
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub jet_temperatures_k: Vec<f64>,
+    /// Conduction through the gas between nearly touching surfaces (particle–fluid–particle and particle–fluid–wall,
+    /// Rong & Horio 1999 as in MFIX-DEM); absent: off, as in seed 000's model. Acts only with a gas (not in
+    /// `vacuum`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub lens_conduction: Option<LensConductionSpec>,
+}
+
+/// The gas lens's parameters (`engine::models::gas_lens`): `lens_conduction: {}` takes MFIX's defaults.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize, schemars::JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct LensConductionSpec {
+    /// f: the lens of gas round the larger particle has radius (1 + f) R (MFIX's FLPC; default 0.2).
+    #[serde(default = "lens_fraction")]
+    pub lens_radius_fraction: f64,
+    /// s, m: the smallest gap the gas conducts across (MFIX's DES_MIN_COND_DIST; default 4e-10).
+    #[serde(default = "lens_min_gap")]
+    pub min_gap_m: f64,
+}
+
+fn lens_fraction() -> f64 {
+    0.2
+}
+
+fn lens_min_gap() -> f64 {
+    4e-10
 }
 
 fn air_conductivity() -> f64 {
@@ -241,6 +266,7 @@ impl Default for GasHeatSpec {
             initial_temperature_k: None,
             inlet_temperature_k: None,
             jet_temperatures_k: Vec::new(),
+            lens_conduction: None,
         }
     }
 }
