@@ -370,7 +370,10 @@ const HEAT_CASES: &[(&str, &str, &str, &[&str])] = &[
         "a gas lens whose smallest gap is a particle's size",
         "  walls: { box_z_lo: { temperature_k: 400.0 } }",
         "  walls: { box_z_lo: { temperature_k: 400.0 } }\n  gas: { lens_conduction: { min_gap_m: 0.01 } }",
-        &["heat.gas.lens_conduction.min_gap_m", "expected a gap well below the particles' radius"],
+        &[
+            "heat.gas.lens_conduction.min_gap_m",
+            "expected a gap well below the particles' radius",
+        ],
     ),
     (
         "a liquid that does not conduct",
