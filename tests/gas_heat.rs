@@ -6,7 +6,7 @@ mod common;
 
 use std::f64::consts::PI;
 
-use common::{built, simulation, whole_and_resumed};
+use common::{KILN, built, whole_and_resumed, with_gas};
 use granflow::engine::Simulation;
 use granflow::engine::state::first_difference;
 
@@ -37,17 +37,6 @@ heat:
   gas: {{ initial_temperature_k: 400.0, heat_capacity_j_per_kg_k: {gas_c}, nusselt: {nusselt} }}
 "#
     )
-}
-
-/// The scenario's simulation with its gas attached.
-fn with_gas(b: &granflow::scenario::BuiltScenario) -> Simulation {
-    let mut sim = simulation(b, 1);
-    if let Some(setup) = &b.gas {
-        let p = &sim.particles;
-        let gas = setup.coupling(&p.position_m, &p.radius_m).expect("the gas builds");
-        sim.attach_gas(gas);
-    }
-    sim
 }
 
 /// Runs `steps` and returns the measured relaxation rate of T_gas − T_p, and h S / (m c) from the model's
@@ -222,33 +211,6 @@ fn the_gas_temperature_restarts_exactly() {
         panic!("the resumed run differs from the uninterrupted one: {diff}");
     }
 }
-
-/// A small kiln (seed 000 §5.1.1, §5.2): the gas is solved only inside the drum (cells whose centres lie outside it
-/// are blocked) with the reference pressure on top, its wall drags the gas round with it, and the wall heats neither
-/// particles nor gas before `from_s`, then both.
-const KILN: &str = r#"
-name: kiln
-domain: { lo_m: [-0.021, -0.021, 0.0], hi_m: [0.021, 0.021, 0.006], periodic: [false, false, true] }
-gravity: { vector_m_per_s2: [0.0, -9.81, 0.0] }
-species:
-  - { name: glass, material: glass, radius_m: 0.0015, youngs_modulus_pa: 1.0e7 }
-contact: { normal: { hertz: { restitution: 0.5 } }, tangential: mindlin }
-walls:
-  - drum: { name: drum, species: glass, axis_point_m: [0.0, 0.0, 0.0], axis: [0.0, 0.0, 1.0], radius_m: 0.02, rotation_rpm: 30.0 }
-fill:
-  - lattice: { species: glass, spacing_m: 0.0031, lo_m: [-0.02, -0.02, 0.0], hi_m: [0.02, -0.005, 0.006], origin_m: [0.0, 0.0, 0.0015], inside_drum: drum }
-time: { dt_s: 2.0e-5, end_time_s: 0.2 }
-gas:
-  density_kg_per_m3: 1.23
-  viscosity_pa_s: 1.8e-5
-  cells: [10, 10, 1]
-  dem_steps_per_gas_step: 20
-  outside_drum: drum
-  drag_coupling: semi_implicit
-heat:
-  initial_temperature_k: 300.0
-  walls: { drum: { temperature_k: 400.0, from_s: 0.02 } }
-"#;
 
 #[test]
 fn a_kiln_solves_the_gas_inside_its_drum_turns_it_with_the_wall_and_heats_from_its_start_time() {

@@ -7,7 +7,7 @@ mod common;
 
 use std::f64::consts::PI;
 
-use common::{built, simulation};
+use common::{KILN, built};
 use granflow::engine::Simulation;
 use granflow::engine::models::gas_lens::GasLens;
 
@@ -24,16 +24,8 @@ fn thermal_mass_j_per_k() -> f64 {
 /// correlation, which at rest (Re = 0) exchanges nothing with the gas, so only the lens moves heat. `lens` is the
 /// `heat.gas` entry, `walls` the `heat.walls` map.
 fn spheres_in_still_gas(positions: &[[f64; 3]], temperatures: &[f64], lens: &str, walls: &str) -> String {
-    let fill: String = positions
-        .iter()
-        .zip(temperatures)
-        .map(|(x, t)| {
-            format!(
-                "  - explicit: {{ species: s, positions_m: [[{}, {}, {}]], temperature_k: {t} }}\n",
-                x[0], x[1], x[2]
-            )
-        })
-        .collect();
+    let fills: Vec<(f64, [f64; 3])> = temperatures.iter().copied().zip(positions.iter().copied()).collect();
+    let fill = common::explicit_fills(&fills);
     format!(
         r#"
 name: lens
@@ -60,14 +52,7 @@ heat:
 }
 
 fn with_gas(yaml: &str) -> Simulation {
-    let b = built(yaml);
-    let mut sim = simulation(&b, 1);
-    if let Some(setup) = &b.gas {
-        let p = &sim.particles;
-        let gas = setup.coupling(&p.position_m, &p.radius_m).expect("the gas builds");
-        sim.attach_gas(gas);
-    }
-    sim
+    common::with_gas(&built(yaml))
 }
 
 const MFIX_LENS: GasLens = GasLens {
@@ -147,31 +132,11 @@ fn without_the_lens_or_without_gas_nothing_crosses_the_gap() {
     }
 }
 
-/// A small glass kiln in air (the drum at 400 K from 0.02 s, 10 × 10 × 1 gas cells inside it) with the lens.
-const KILN_WITH_LENS: &str = r#"
-name: kiln-lens
-domain: { lo_m: [-0.021, -0.021, 0.0], hi_m: [0.021, 0.021, 0.006], periodic: [false, false, true] }
-gravity: { vector_m_per_s2: [0.0, -9.81, 0.0] }
-species:
-  - { name: glass, material: glass, radius_m: 0.0015, youngs_modulus_pa: 1.0e7 }
-contact: { normal: { hertz: { restitution: 0.5 } }, tangential: mindlin }
-walls:
-  - drum: { name: drum, species: glass, axis_point_m: [0.0, 0.0, 0.0], axis: [0.0, 0.0, 1.0], radius_m: 0.02, rotation_rpm: 30.0 }
-fill:
-  - lattice: { species: glass, spacing_m: 0.0031, lo_m: [-0.02, -0.02, 0.0], hi_m: [0.02, -0.005, 0.006], origin_m: [0.0, 0.0, 0.0015], inside_drum: drum }
-time: { dt_s: 2.0e-5, end_time_s: 0.2 }
-gas:
-  density_kg_per_m3: 1.23
-  viscosity_pa_s: 1.8e-5
-  cells: [10, 10, 1]
-  dem_steps_per_gas_step: 20
-  outside_drum: drum
-  drag_coupling: semi_implicit
-heat:
-  initial_temperature_k: 300.0
-  walls: { drum: { temperature_k: 400.0, from_s: 0.02 } }
-  gas: { lens_conduction: {} }
-"#;
+/// The gas-heat tests' small glass kiln in air (the drum at 400 K from 0.02 s, 10 × 10 × 1 gas cells inside it) with
+/// the lens.
+fn kiln_with_lens() -> String {
+    format!("{KILN}  gas: {{ lens_conduction: {{}} }}\n")
+}
 
 /// With the lens the kiln's glass bed takes more heat from its wall than without (glass conducts little through its
 /// contact spots), and its temperatures are the same bits on 1 and 2 threads and across a restart.
@@ -183,13 +148,13 @@ fn a_kiln_with_the_lens_heats_faster_and_restarts_to_the_same_bits_on_any_thread
         let t = &sim.particles.temperature_k;
         t.iter().sum::<f64>() / t.len() as f64
     };
-    let with_lens = mean_temperature(KILN_WITH_LENS);
-    let without = mean_temperature(&KILN_WITH_LENS.replace("  gas: { lens_conduction: {} }\n", ""));
+    let with_lens = mean_temperature(&kiln_with_lens());
+    let without = mean_temperature(KILN);
     println!("small glass kiln after 0.18 s of heating: mean {with_lens:.4} K with the lens, {without:.4} K without");
     assert!(with_lens - 300.0 > 2.0 * (without - 300.0), "{with_lens} vs {without}");
 
     let tmp = tempfile::tempdir().expect("temp dir");
-    let (whole, split) = common::whole_and_resumed(tmp.path(), KILN_WITH_LENS, 5_010);
+    let (whole, split) = common::whole_and_resumed(tmp.path(), &kiln_with_lens(), 5_010);
     assert_eq!(whole.step, 10_000);
     // The summary reports the lens's Biot number: glass (k_s 1.7 W/(m K)) in air is not far below 1 at its contacts.
     let summary: serde_json::Value =

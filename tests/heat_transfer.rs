@@ -25,15 +25,7 @@ fn mass_kg() -> f64 {
 /// A box with a floor (the `box_y_lo` wall) under gravity along −y, spheres placed explicitly, one fill per
 /// temperature; `extra_species` and `heat_walls` go into the species entry and the `heat.walls` map.
 fn stacked(fills: &[(f64, [f64; 3])], extra_species: &str, heat_walls: &str, gravity: f64) -> String {
-    let fill: String = fills
-        .iter()
-        .map(|(t, x)| {
-            format!(
-                "  - explicit: {{ species: s, positions_m: [[{}, {}, {}]], temperature_k: {t} }}\n",
-                x[0], x[1], x[2]
-            )
-        })
-        .collect();
+    let fill = common::explicit_fills(fills);
     format!(
         r#"
 name: heat

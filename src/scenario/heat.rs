@@ -63,17 +63,22 @@ pub(super) fn build_heat(
     }
     // The gas's properties are checked whether or not the scenario has a gas (a campaign may switch it off).
     let g = &heat.gas;
-    for (key, value) in [
+    // Each (key under `heat.gas`, value) must be finite and > 0.
+    let positive = |entries: &[(&str, f64)]| {
+        for &(key, value) in entries {
+            if !(value.is_finite() && value > 0.0) {
+                return Err(fail(
+                    format!("heat.gas.{key}"),
+                    format!("expected a finite value > 0, got {value}"),
+                ));
+            }
+        }
+        Ok(())
+    };
+    positive(&[
         ("conductivity_w_per_m_k", g.conductivity_w_per_m_k),
         ("heat_capacity_j_per_kg_k", g.heat_capacity_j_per_kg_k),
-    ] {
-        if !(value.is_finite() && value > 0.0) {
-            return Err(fail(
-                format!("heat.gas.{key}"),
-                format!("expected a finite value > 0, got {value}"),
-            ));
-        }
-    }
+    ])?;
     g.nusselt
         .check()
         .map_err(|(key, message)| fail(format!("heat.gas.nusselt.{key}"), message))?;
@@ -189,17 +194,10 @@ pub(super) fn build_heat(
         );
     }
     if let Some(lens) = g.lens_conduction {
-        for (key, value) in [
-            ("lens_radius_fraction", lens.lens_radius_fraction),
-            ("min_gap_m", lens.min_gap_m),
-        ] {
-            if !(value.is_finite() && value > 0.0) {
-                return Err(fail(
-                    format!("heat.gas.lens_conduction.{key}"),
-                    format!("expected a finite value > 0, got {value}"),
-                ));
-            }
-        }
+        positive(&[
+            ("lens_conduction.lens_radius_fraction", lens.lens_radius_fraction),
+            ("lens_conduction.min_gap_m", lens.min_gap_m),
+        ])?;
         if lens.min_gap_m >= particles.max_radius_m().max(f64::MIN_POSITIVE) {
             return Err(fail(
                 "heat.gas.lens_conduction.min_gap_m".into(),

@@ -106,3 +106,54 @@ time: { dt_s: 1.0e-5, end_time_s: 0.08 }
 output: { checkpoint_every_steps: 2000, keep_checkpoints: 2, series_every_steps: 500 }
 seed: 5
 "#;
+
+/// The scenario's simulation with its gas attached.
+pub fn with_gas(b: &BuiltScenario) -> Simulation {
+    let mut sim = simulation(b, 1);
+    if let Some(setup) = &b.gas {
+        let p = &sim.particles;
+        let gas = setup.coupling(&p.position_m, &p.radius_m).expect("the gas builds");
+        sim.attach_gas(gas);
+    }
+    sim
+}
+
+/// The `fill:` entries placing one sphere of species `s` at each position with its own temperature.
+pub fn explicit_fills(fills: &[(f64, [f64; 3])]) -> String {
+    fills
+        .iter()
+        .map(|(t, x)| {
+            format!(
+                "  - explicit: {{ species: s, positions_m: [[{}, {}, {}]], temperature_k: {t} }}\n",
+                x[0], x[1], x[2]
+            )
+        })
+        .collect()
+}
+
+/// A small kiln (seed 000 §5.1.1, §5.2): the gas is solved only inside the drum (cells whose centres lie outside it
+/// are blocked) with the reference pressure on top, its wall drags the gas round with it, and the wall heats neither
+/// particles nor gas before `from_s`, then both.
+pub const KILN: &str = r#"
+name: kiln
+domain: { lo_m: [-0.021, -0.021, 0.0], hi_m: [0.021, 0.021, 0.006], periodic: [false, false, true] }
+gravity: { vector_m_per_s2: [0.0, -9.81, 0.0] }
+species:
+  - { name: glass, material: glass, radius_m: 0.0015, youngs_modulus_pa: 1.0e7 }
+contact: { normal: { hertz: { restitution: 0.5 } }, tangential: mindlin }
+walls:
+  - drum: { name: drum, species: glass, axis_point_m: [0.0, 0.0, 0.0], axis: [0.0, 0.0, 1.0], radius_m: 0.02, rotation_rpm: 30.0 }
+fill:
+  - lattice: { species: glass, spacing_m: 0.0031, lo_m: [-0.02, -0.02, 0.0], hi_m: [0.02, -0.005, 0.006], origin_m: [0.0, 0.0, 0.0015], inside_drum: drum }
+time: { dt_s: 2.0e-5, end_time_s: 0.2 }
+gas:
+  density_kg_per_m3: 1.23
+  viscosity_pa_s: 1.8e-5
+  cells: [10, 10, 1]
+  dem_steps_per_gas_step: 20
+  outside_drum: drum
+  drag_coupling: semi_implicit
+heat:
+  initial_temperature_k: 300.0
+  walls: { drum: { temperature_k: 400.0, from_s: 0.02 } }
+"#;
