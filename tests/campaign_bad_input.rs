@@ -579,6 +579,16 @@ const CASES: &[(&str, &str, &str, &[&str])] = &[
         ],
     ),
     (
+        "a convective ratio of a metric that is not an h_w",
+        "analysis: { mixing_species: red }",
+        "derived: [ { convective_to_conductive_ratio: { vacuum_param: rotation_rpm, h_w_metric: lacey_index } } ]\nanalysis: { mixing_species: red }",
+        &[
+            "key `derived[0].convective_to_conductive_ratio.h_w_metric`",
+            "expected one of `wall_heat_transfer_coefficient_w_per_m2_k`",
+            "`wall_heat_transfer_coefficient_bed_w_per_m2_k`, got `lacey_index`",
+        ],
+    ),
+    (
         "heating fit after the end",
         "analysis: { mixing_species: red }",
         "analysis: { mixing_species: red, heating_fit_from_s: 0.5 }",

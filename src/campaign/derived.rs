@@ -20,31 +20,68 @@ pub enum DerivedSpec {
         velocity_param: String,
     },
     /// The convective/conductive split of a heated drum's h_w (seed 000 Fig. 72): (h_w(air) − h_w(vacuum)) /
-    /// h_w(vacuum) from the pair of jobs with and without gas that share every other parameter. Needs the metric
-    /// `wall_heat_transfer_coefficient_w_per_m2_k`.
+    /// h_w(vacuum) from the pair of jobs with and without gas that share every other parameter. Needs the h_w
+    /// metric it reads (`h_w_metric`) in `metrics`.
     ConvectiveToConductiveRatio {
         /// The sweep parameter (its `name:` or path) switching the gas off: `gas.vacuum`, true or false.
         vacuum_param: String,
+        /// Which h_w: `wall_heat_transfer_coefficient_w_per_m2_k` (the core's, the default),
+        /// `wall_heat_transfer_coefficient_inner_core_w_per_m2_k` or `wall_heat_transfer_coefficient_bed_w_per_m2_k`.
+        #[serde(default = "core_wall_heat_transfer_coefficient")]
+        #[schemars(default = "core_wall_heat_transfer_coefficient")]
+        h_w_metric: JobMetric,
     },
 }
 
+fn core_wall_heat_transfer_coefficient() -> JobMetric {
+    JobMetric::WallHeatTransferCoefficient
+}
+
+/// The h_w metrics a convective/conductive ratio can read.
+const WALL_HEAT_TRANSFER_COEFFICIENTS: [JobMetric; 3] = [
+    JobMetric::WallHeatTransferCoefficient,
+    JobMetric::WallHeatTransferCoefficientInnerCore,
+    JobMetric::WallHeatTransferCoefficientBed,
+];
+
 impl DerivedSpec {
     /// The per-job metrics it is computed from.
-    pub fn required_metrics(&self) -> &'static [JobMetric] {
+    pub fn required_metrics(&self) -> Vec<JobMetric> {
         match self {
-            DerivedSpec::MinimumFluidizationVelocity { .. } => &[
+            DerivedSpec::MinimumFluidizationVelocity { .. } => vec![
                 JobMetric::PressureDropMean,
                 JobMetric::PressureDropStd,
                 JobMetric::BedWeightPerArea,
             ],
-            DerivedSpec::ConvectiveToConductiveRatio { .. } => &[JobMetric::WallHeatTransferCoefficient],
+            DerivedSpec::ConvectiveToConductiveRatio { h_w_metric, .. } => vec![*h_w_metric],
+        }
+    }
+
+    /// What is wrong with its own fields, if anything: a key below it and a message.
+    pub fn invalid_field(&self) -> Option<(&'static str, String)> {
+        match self {
+            DerivedSpec::ConvectiveToConductiveRatio { h_w_metric, .. }
+                if !WALL_HEAT_TRANSFER_COEFFICIENTS.contains(h_w_metric) =>
+            {
+                Some((
+                    "convective_to_conductive_ratio.h_w_metric",
+                    format!(
+                        "expected one of {}, got `{}`",
+                        WALL_HEAT_TRANSFER_COEFFICIENTS
+                            .map(|m| format!("`{}`", m.name()))
+                            .join(", "),
+                        h_w_metric.name()
+                    ),
+                ))
+            }
+            _ => None,
         }
     }
 
     pub fn param(&self) -> &str {
         match self {
             DerivedSpec::MinimumFluidizationVelocity { velocity_param } => velocity_param,
-            DerivedSpec::ConvectiveToConductiveRatio { vacuum_param } => vacuum_param,
+            DerivedSpec::ConvectiveToConductiveRatio { vacuum_param, .. } => vacuum_param,
         }
     }
 }
@@ -97,9 +134,12 @@ pub fn compute(specs: &[DerivedSpec], header: &[String], rows: &[Vec<Value>]) ->
     let mut out = Vec::new();
     for spec in specs {
         match spec {
-            DerivedSpec::ConvectiveToConductiveRatio { vacuum_param } => {
+            DerivedSpec::ConvectiveToConductiveRatio {
+                vacuum_param,
+                h_w_metric,
+            } => {
                 let vacuum = column(&format!("param.{vacuum_param}"));
-                let h_w = metric_column(JobMetric::WallHeatTransferCoefficient);
+                let h_w = metric_column(*h_w_metric);
                 for (group_json, rows) in groups(vacuum_param) {
                     // The mean h_w of the group's jobs in air and in vacuum (one each in a plain sweep).
                     let mean_where = |in_vacuum: bool| {
@@ -188,6 +228,7 @@ mod tests {
     use serde_json::{Value, json};
 
     use super::{DerivedSpec, compute};
+    use crate::campaign::metrics::JobMetric;
 
     /// Each (material, speed) group pairs its air and vacuum jobs; the store keeps the boolean as text; a job that
     /// did not finish does not count.
@@ -213,6 +254,7 @@ mod tests {
         ];
         let spec = DerivedSpec::ConvectiveToConductiveRatio {
             vacuum_param: "vacuum".into(),
+            h_w_metric: JobMetric::WallHeatTransferCoefficient,
         };
         let out = compute(&[spec], &header, &rows);
         let value = |material: &str| {

@@ -146,6 +146,10 @@ job_metrics! {
         "the same from the inner core (half the core's radius): seed 000 Fig. 69, the core region changes h_w";
     CoreHeatingSlope => "core_heating_slope_per_s", "1/s", [HeatedDrum],
         "the fitted slope of ln((T_w - <T_c>)/(T_w - T_0)) against t (seed 000 eq. 5.19, Fig. 70)";
+    WallHeatTransferCoefficientBed => "wall_heat_transfer_coefficient_bed_w_per_m2_k", "W/(m2 K)", [HeatedDrum],
+        "the same with the whole bed as the core: <T_c> the particles' mass-weighted mean temperature, so the fit is the bed's own energy balance w c_p dT/dt = h_w A (T_w - T) (seed 000 eq. 5.20); free of the lag with which heat reaches a core by mixing";
+    BedHeatingSlope => "bed_heating_slope_per_s", "1/s", [HeatedDrum],
+        "the fitted slope of ln((T_w - <T>)/(T_w - T_0)) against t with <T> the particles' mean temperature";
     DrumContactArc => "drum_contact_arc_rad", "rad", [HeatedDrum],
         "the angle of drum wall the bed touches, mean over the fit window";
     DrumWallContactTime => "drum_wall_contact_time_s", "s", [HeatedDrum],

@@ -153,8 +153,11 @@ fn expand(
     let points = sweep::expand(&spec.sweep, "sweep", spec.max_jobs).map_err(|e| invalid(path, e.key, e.message))?;
     let names = sweep::axis_names(&spec.sweep);
     for (k, d) in spec.derived.iter().enumerate() {
+        if let Some((key, message)) = d.invalid_field() {
+            return Err(invalid(path, format!("derived[{k}].{key}"), message));
+        }
         for m in d.required_metrics() {
-            if !job_metrics.contains(m) {
+            if !job_metrics.contains(&m) {
                 return Err(invalid(
                     path,
                     format!("derived[{k}]"),

@@ -168,6 +168,8 @@ pub fn metrics(job: &JobSpec, built: &BuiltScenario, sim: &Simulation, series: &
     let cycle = || cycle_once.get_or_init(|| cycle(job, built, sim, series)).as_ref();
     let core_once = std::cell::OnceCell::new();
     let core = || *core_once.get_or_init(|| wall_heat(job, sim, series, "core_temperature_k"));
+    let bed_once = std::cell::OnceCell::new();
+    let bed = || *bed_once.get_or_init(|| wall_heat(job, sim, series, "mean_temperature_k"));
     job.metrics
         .iter()
         .map(|&metric| {
@@ -259,6 +261,8 @@ pub fn metrics(job: &JobSpec, built: &BuiltScenario, sim: &Simulation, series: &
                         .map_or(f64::NAN, |(f, _)| f.coefficient_w_per_m2_k)
                 }
                 JobMetric::CoreHeatingSlope => core().map_or(f64::NAN, |(f, _)| f.slope_per_s),
+                JobMetric::WallHeatTransferCoefficientBed => bed().map_or(f64::NAN, |(f, _)| f.coefficient_w_per_m2_k),
+                JobMetric::BedHeatingSlope => bed().map_or(f64::NAN, |(f, _)| f.slope_per_s),
                 JobMetric::DrumContactArc => core().map_or(f64::NAN, |(_, arc)| arc),
                 JobMetric::DrumWallContactTime => core().map_or(f64::NAN, |(f, _)| f.contact_time_s),
             };
@@ -555,7 +559,7 @@ fn stepped_onset_m_per_s(job: &JobSpec, built: &BuiltScenario, sim: &Simulation,
     analysis::fluidization::minimum_fluidization(&points).map_or(f64::NAN, |m| m.from_sustained_fluctuations_m_per_s)
 }
 
-/// h_w of the run's heated drum from the series column `core_column` (a core temperature), fitted from
+/// h_w of the run's heated drum from the series column `core_column` (a core or the bed's mean temperature), fitted from
 /// `analysis.heating_fit_from_s` (default: when the wall starts heating) to the end, with T_0 the core's temperature
 /// at the first row from the wall's start, and the contact arc's mean over the fit window (returned beside the fit).
 /// `None` without a heated drum, its columns or enough rows.
