@@ -9,6 +9,7 @@ use std::path::Path;
 
 use common::{WET_DRUM, built, granflow, simulation};
 use granflow::checkpoint::CheckpointSeries;
+use granflow::engine::Vec3;
 use granflow::engine::models::capillary::mikami_force_n;
 use granflow::engine::models::capillary_table::CapillaryTable;
 use granflow::engine::state::{SimState, first_difference};
@@ -110,6 +111,50 @@ fn a_wet_drum_gives_the_same_bits_with_one_or_two_neighbour_list_levels() {
     if let Some(diff) = first_difference(&single.snapshot(), &refiltered.snapshot()) {
         panic!("the two-level list changes the wet drum: {diff}");
     }
+}
+
+/// A liquid-bridge run without liquid and without a spray (the dry beds of a wet sweep) can never form a bridge: it
+/// takes the dry force pass and skips the liquid inventory, and moves its particles exactly as the same drum
+/// without cohesion does, to the bit, on one and two threads (the drum with a spray, and the same dry drum wetted,
+/// are the controls: there the bridges act).
+#[test]
+fn a_liquid_bridge_drum_without_liquid_moves_exactly_as_a_dry_one() {
+    let dry_wet_model = WET_DRUM
+        .replace("liquid_content: 0.01", "liquid_content: 0.0")
+        .replace(", spray: { max_liquid_content: 0.02, every_steps: 50 }", "");
+    assert!(!dry_wet_model.contains("liquid_content: 0.01") && !dry_wet_model.contains("spray"));
+    let no_model = dry_wet_model
+        .lines()
+        .filter(|l| !l.starts_with("cohesion:"))
+        .collect::<Vec<_>>()
+        .join("\n");
+    let wetted = dry_wet_model.replace("liquid_content: 0.0", "liquid_content: 0.01");
+    let motion = |yaml: &str, threads: usize| {
+        let mut sim = simulation(&built(yaml), threads);
+        sim.run_steps(3000).expect("stable");
+        let p = sim.snapshot().particles;
+        (
+            p.position_m,
+            p.velocity_m_per_s,
+            p.angular_velocity_rad_per_s,
+            sim.timers.liquid,
+        )
+    };
+    let bits = |m: &(Vec<Vec3>, Vec<Vec3>, Vec<Vec3>, std::time::Duration)| -> Vec<u64> {
+        [&m.0, &m.1, &m.2]
+            .iter()
+            .flat_map(|v| v.iter().flat_map(|x| x.iter().map(|c| c.to_bits())))
+            .collect()
+    };
+    let reference = bits(&motion(&no_model, 1));
+    for threads in [1, 2] {
+        let inert = motion(&dry_wet_model, threads);
+        assert_eq!(bits(&inert), reference, "{threads} thread(s)");
+        assert_eq!(inert.3, std::time::Duration::ZERO, "the liquid inventory ran");
+    }
+    let wet = motion(&wetted, 1);
+    assert_ne!(bits(&wet), reference, "the wetted control moves like the dry drum");
+    assert!(wet.3 > std::time::Duration::ZERO);
 }
 
 fn final_state(dir: &Path) -> SimState {

@@ -16,6 +16,7 @@ use super::contacts::AlignedHistory;
 use super::gas::coupled::GasCoupling;
 use super::integrate::{InverseInertia, find_lost, kick_drift};
 use super::liquid::{BridgeCache, step_liquid, total_liquid_m3};
+use super::models::cohesion_law::CohesionModel;
 use super::neighbor::{Criteria, NeighborList};
 use super::net_force::NetForceTally;
 use super::pair_pass::{ForcePass, HalfKick, PairBuffers, add_wall_forces, compute_pair_forces};
@@ -76,6 +77,11 @@ struct Workspace {
     steps_since_rebalance: u64,
     /// Each wall's temperature at the current step (heat transfer; `None` while adiabatic).
     wall_temperature_k: Vec<Option<f64>>,
+    /// The run's cohesion can never act: liquid bridges without a spray, and no liquid on any particle or in any
+    /// bridge, so no bridge can ever form (the dry beds of a wet sweep). The steps then skip the liquid inventory
+    /// and take the dry force pass: the same forces, since the cohesion kernels add exact zeros there, and the
+    /// neighbour lists keep the cohesion's reach (`SimConfig::reach`), so the same bits.
+    cohesion_inert: bool,
     /// Threads of the per-step parallel force pass, which also run the drift of an unfused step and the neighbour
     /// lists' work (shared with that work through the `Arc`).
     team: Arc<Team>,
@@ -136,6 +142,7 @@ impl Workspace {
             accumulators_zeroed: false,
             steps_since_rebalance: 0,
             wall_temperature_k: Vec::new(),
+            cohesion_inert: false,
             team: Arc::new(Team::new(threads)),
         }
     }
@@ -170,6 +177,7 @@ impl Simulation {
             timers: StageTimers::default(),
         };
         sim.refresh_neighbors();
+        sim.work.cohesion_inert = sim.cohesion_is_inert();
         // The first half kick needs F(0). With dt = 0 the tangential springs do not move (and nothing is sprayed).
         sim.step_liquid(0.0);
         let pass = sim.forces(0.0, None);
@@ -225,8 +233,22 @@ impl Simulation {
             return Err(NumericalError::OrphanContacts { count: orphans });
         }
         self.history = history;
+        self.work.cohesion_inert = self.cohesion_is_inert();
         self.rebalance();
         Ok(())
+    }
+
+    /// Whether the run's cohesion can never act from this state on (see `Workspace::cohesion_inert`): liquid
+    /// bridges without a spray (nothing else adds liquid) and not a drop of liquid on the particles or in bridges.
+    fn cohesion_is_inert(&self) -> bool {
+        let Some(CohesionModel::LiquidBridge(b)) = self.config.cohesion.as_ref().map(|c| &c.model) else {
+            return false;
+        };
+        let dry = |v: &[f64]| v.iter().all(|&x| x == 0.0);
+        b.spray.is_none()
+            && dry(&self.particles.liquid_m3)
+            && dry(&self.history.pair.cohesion.bridge_volume_m3)
+            && dry(&self.history.wall.cohesion.bridge_volume_m3)
     }
 
     /// Sorts the particles by place (`engine::particle_order`, `neighbor.sort_every_steps`): the state is taken as
@@ -501,7 +523,7 @@ impl Simulation {
                 dt,
                 &self.work.list,
                 &self.history,
-                config.cohesion.as_ref(),
+                config.cohesion.as_ref().filter(|_| !self.work.cohesion_inert),
                 &self.work.bridges,
                 &mut tally.wall_contact_n,
                 &mut tally.wall_cohesion_n,
@@ -579,7 +601,7 @@ impl Simulation {
             &self.work.team,
             kick,
             self.work.accumulators_zeroed,
-            self.config.cohesion.as_ref(),
+            self.config.cohesion.as_ref().filter(|_| !self.work.cohesion_inert),
             &self.work.bridges,
             &self.work.wall_temperature_k,
         );
@@ -592,7 +614,7 @@ impl Simulation {
     /// rupture at the current positions (`engine::liquid`).
     fn step_liquid(&mut self, dt: f64) {
         let config = Arc::clone(&self.config);
-        let Some(cohesion) = config.cohesion.as_ref() else {
+        let Some(cohesion) = config.cohesion.as_ref().filter(|_| !self.work.cohesion_inert) else {
             return;
         };
         let t = Instant::now();
