@@ -49,6 +49,11 @@ pub fn job_dir(dir: &Path, job_id: &str) -> PathBuf {
     jobs_path(dir).join(job_id)
 }
 
+/// The directory of one shared preparation (`campaign::prepare`).
+pub fn preparation_dir(dir: &Path, preparation_id: &str) -> PathBuf {
+    dir.join("preparations").join(preparation_id)
+}
+
 /// A job directory's description of the job (`campaign::JobSpec`).
 pub fn job_spec_path(job_dir: &Path) -> PathBuf {
     job_dir.join("job.json")

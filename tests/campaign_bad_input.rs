@@ -589,6 +589,32 @@ const CASES: &[(&str, &str, &str, &[&str])] = &[
         ],
     ),
     (
+        "a preparation to after the jobs' end",
+        "checkpoint: { every_steps: 1000, keep: 2 }",
+        "checkpoint: { every_steps: 1000, keep: 2 }\nprepare: { until_s: 0.002, shared_across: [rotation_rpm] }",
+        &[
+            "key `prepare.until_s`",
+            "expected a time before the jobs end (time.end_time_s = 0.002 s), got 0.002 s",
+        ],
+    ),
+    (
+        "a preparation shared across an axis the sweep does not have",
+        "checkpoint: { every_steps: 1000, keep: 2 }",
+        "checkpoint: { every_steps: 1000, keep: 2 }\nprepare: { until_s: 0.001, shared_across: [rotation_rmp] }",
+        &[
+            "key `prepare.shared_across[0]`",
+            "`rotation_rmp` is not a sweep axis; the sweep has",
+            "rotation_rpm",
+            "fill_top_m",
+        ],
+    ),
+    (
+        "a preparation of no time",
+        "checkpoint: { every_steps: 1000, keep: 2 }",
+        "checkpoint: { every_steps: 1000, keep: 2 }\nprepare: { until_s: -0.001, shared_across: [rotation_rpm] }",
+        &["key `prepare.until_s`", "expected a time > 0 s, got -0.001"],
+    ),
+    (
         "heating fit after the end",
         "analysis: { mixing_species: red }",
         "analysis: { mixing_species: red, heating_fit_from_s: 0.5 }",

@@ -8,6 +8,7 @@
 use serde::{Deserialize, Serialize};
 
 use super::metrics::JobMetric;
+use super::prepare::Preparation;
 use super::spec::AnalysisSpec;
 use crate::scenario::ScenarioSpec;
 
@@ -28,6 +29,9 @@ pub struct JobSpec {
     /// Written by name (`"lacey_index"`), so the job's id is that of the names.
     pub metrics: Vec<JobMetric>,
     pub analysis: AnalysisSpec,
+    /// The shared preparation the job starts from (`prepare` in the campaign file); not part of the id.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub prepared: Option<Preparation>,
 }
 
 impl JobSpec {

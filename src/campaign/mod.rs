@@ -7,6 +7,7 @@
 pub mod derived;
 pub mod job;
 pub mod metrics;
+pub mod prepare;
 pub mod spec;
 pub mod sweep;
 pub mod validation;
@@ -202,13 +203,18 @@ fn expand(
             });
         }
     }
+    let swept: Vec<String> = param_keys.keys().cloned().collect();
+    let shared = match &spec.prepare {
+        Some(p) => prepare::shared_paths(p, &swept, &names).map_err(|(key, m)| invalid(path, key, m))?,
+        None => Vec::new(),
+    };
     let base = base_document(&spec);
     let mut jobs = Vec::with_capacity(points.len());
     let mut seen: HashMap<String, usize> = HashMap::new();
     // The points as written, to find which value two points that make one job spell differently.
     let written_points = points.clone();
     for (ordinal, point) in points.into_iter().enumerate() {
-        let job = resolve(&spec, &job_metrics, &base, point, ordinal, param_keys, path)?;
+        let job = resolve(&spec, &job_metrics, &base, point, ordinal, param_keys, &shared, path)?;
         if let Some(&first) = seen.get(&job.job_id) {
             let error = invalid(
                 path,
@@ -229,6 +235,9 @@ fn expand(
         }
         seen.insert(job.job_id.clone(), ordinal);
         jobs.push(job);
+    }
+    if let Some(p) = &spec.prepare {
+        attach_preparations(&mut jobs, p.until_s, &shared).map_err(|(key, m)| invalid(path, key, m))?;
     }
     Ok(Campaign {
         spec,
@@ -327,6 +336,26 @@ fn check_name(name: &str) -> Result<(), String> {
     Ok(())
 }
 
+/// Gives every job its preparation ([`prepare::preparation`]), with the shared parameters at the values of the
+/// sweep's first job and of its last.
+fn attach_preparations(jobs: &mut [JobSpec], until_s: f64, shared: &[String]) -> Result<(), (String, String)> {
+    let values_of = |job: &JobSpec| -> Vec<serde_json::Value> {
+        let doc = serde_json::to_value(&job.scenario).expect("a scenario serialises");
+        shared
+            .iter()
+            .map(|p| sweep::get_path(&doc, p).cloned().unwrap_or(serde_json::Value::Null))
+            .collect()
+    };
+    let (Some(first_job), Some(last_job)) = (jobs.first(), jobs.last()) else {
+        return Ok(());
+    };
+    let (first, last) = (values_of(first_job), values_of(last_job));
+    for job in jobs.iter_mut() {
+        job.prepared = Some(prepare::preparation(&job.scenario, until_s, shared, &first, &last)?);
+    }
+    Ok(())
+}
+
 /// The base scenario as a JSON document with every field present (defaults included), the campaign's name and
 /// checkpoint policy filled in.
 fn base_document(spec: &CampaignSpec) -> serde_json::Value {
@@ -339,7 +368,9 @@ fn base_document(spec: &CampaignSpec) -> serde_json::Value {
 
 /// Applies one sweep point to the base and derives the job's seed and id; every job reduces `metrics` (the spec's,
 /// checked by [`metrics::check`]). `param_keys` gives the key in the campaign file where each parameter path is set
-/// (for messages).
+/// (for messages). The seed derives from the campaign seed and the point's parameters other than `shared` (those a
+/// preparation is shared across: the jobs of one preparation share its random numbers).
+#[allow(clippy::too_many_arguments)]
 fn resolve(
     spec: &CampaignSpec,
     metrics: &[metrics::JobMetric],
@@ -347,6 +378,7 @@ fn resolve(
     mut point: sweep::Point,
     ordinal: usize,
     param_keys: &HashMap<String, String>,
+    shared: &[String],
     path: &Path,
 ) -> Result<JobSpec, ConfigError> {
     let mut doc = base.clone();
@@ -412,7 +444,8 @@ fn resolve(
         }
     }
     if !point.iter().any(|(p, _)| p == "seed") {
-        let params = serde_json::to_string(&point).expect("params serialise");
+        let seeded: Vec<&(String, serde_json::Value)> = point.iter().filter(|(p, _)| !shared.contains(p)).collect();
+        let params = serde_json::to_string(&seeded).expect("params serialise");
         let mut bytes = spec.seed.to_le_bytes().to_vec();
         bytes.extend_from_slice(params.as_bytes());
         scenario.seed = xxhash_rust::xxh3::xxh3_64(&bytes);
@@ -426,6 +459,7 @@ fn resolve(
         scenario,
         metrics: metrics.to_vec(),
         analysis: spec.analysis.clone(),
+        prepared: None,
     };
     job.job_id = job.compute_id();
     Ok(job)
@@ -490,7 +524,16 @@ pub fn validate_jobs<'a>(
         return Ok(());
     };
     let base = base_document(&campaign.spec);
-    let base_job = resolve(&campaign.spec, &job.metrics, &base, Vec::new(), 0, &param_keys, path)?;
+    let base_job = resolve(
+        &campaign.spec,
+        &job.metrics,
+        &base,
+        Vec::new(),
+        0,
+        &param_keys,
+        &[],
+        path,
+    )?;
     let base_fails_alike = matches!(
         job_error(&base_job, path),
         Err(ConfigError::Invalid { key: k, message: m, .. }) if k == key && m == message

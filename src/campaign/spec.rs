@@ -42,6 +42,10 @@ pub struct CampaignSpec {
     /// Campaign-level metrics computed from several jobs (e.g. u_mf from a velocity sweep).
     #[serde(default)]
     pub derived: Vec<super::derived::DerivedSpec>,
+    /// Run the first seconds of jobs that cannot differ before then once per group of them, and start each job
+    /// from that state (`campaign::prepare`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub prepare: Option<super::prepare::PrepareSpec>,
     /// A validation campaign: the case it reproduces and the checks `granflow report` evaluates.
     #[serde(default)]
     pub validation: Option<super::validation::ValidationSpec>,

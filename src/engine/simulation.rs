@@ -629,6 +629,8 @@ impl Simulation {
             self.time_s,
             self.step,
             dt,
+            self.work.drift_bound_m,
+            config.inner_skin_m,
         );
         self.sprayed_m3 += events.sprayed_m3;
         self.cohesion_events.bridges_formed += events.bridges_formed;

@@ -10,6 +10,7 @@
 //! happens when the dispatcher dies, even by `kill -9`; whatever it computed since its last checkpoint is lost, and
 //! nothing is corrupted, since every file it writes is written to a temporary name and renamed.
 
+mod prepared;
 pub mod protocol;
 mod reduce;
 pub mod rereduce;
@@ -143,6 +144,16 @@ fn run(opts: &WorkerOptions) -> Result<i32, Error> {
     }
     let built = crate::scenario::build(job.scenario.clone(), &job_spec_path(dir))?;
     let start = Instant::now();
+    let mut preparing_s = None;
+    if let Some(prep) = &job.prepared {
+        match prepared::ensure_started(dir, &job, prep, &built, opts.threads, &stop)? {
+            prepared::Start::Ready => preparing_s = Some(start.elapsed().as_secs_f64()),
+            prepared::Start::Stopped => {
+                emit(Event::Stopped { step: 0 });
+                return Ok(EXIT_PREEMPTED);
+            }
+        }
+    }
     let mut observer = WorkerObserver::new(&job, &built)?;
     let (summary, sim) = run_in_dir(
         &built,
@@ -171,12 +182,14 @@ fn run(opts: &WorkerOptions) -> Result<i32, Error> {
         job_id: job.job_id.clone(),
         metrics,
         // This invocation's engine stages follow (after a resume, only the part since the resume).
+        // `prepare` (part of simulate): running, waiting for or adopting the shared preparation.
         timings: [
             ("simulate".into(), simulate_s),
             ("checkpoint".into(), summary.checkpoint_time_s),
             ("reduce".into(), reduce_s),
         ]
         .into_iter()
+        .chain(preparing_s.map(|s| ("prepare".to_string(), s)))
         .chain(sim.stage_timings())
         .collect(),
         steps: sim.step,
@@ -227,6 +240,8 @@ struct WorkerObserver {
     job_id: String,
     total_steps: u64,
     mixing: Option<reduce::MixingSampler>,
+    /// False while running a shared preparation: its progress is the job's heartbeat, but the job has not started.
+    announce_start: bool,
 }
 
 impl WorkerObserver {
@@ -235,7 +250,18 @@ impl WorkerObserver {
             job_id: job.job_id.clone(),
             total_steps: 0,
             mixing: reduce::MixingSampler::new(job, built),
+            announce_start: true,
         })
+    }
+
+    /// For a shared preparation of `job`, whose scenario is `built`: the same series columns, no start message.
+    fn preparing(job: &JobSpec, built: &crate::scenario::BuiltScenario) -> Self {
+        WorkerObserver {
+            job_id: job.job_id.clone(),
+            total_steps: 0,
+            mixing: reduce::MixingSampler::new(job, built),
+            announce_start: false,
+        }
     }
 }
 
@@ -262,6 +288,9 @@ impl RunObserver for WorkerObserver {
                 resumed_from_step,
             } => {
                 self.total_steps = total_steps;
+                if !self.announce_start {
+                    return;
+                }
                 emit(Event::Started {
                     job_id: self.job_id.clone(),
                     step,
