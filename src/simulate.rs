@@ -345,9 +345,11 @@ fn series_row(sim: &mut Simulation, built: &BuiltScenario) -> String {
     )
 }
 
-/// Keeps the header and the rows up to `step` of an existing series file. When `resuming`, a file whose header
-/// differs from `header` (written by another granflow version) is refused and left as it is: its rows would not fit
-/// the header, and dropping them would lose finished work silently.
+/// When `resuming` from the checkpoint at `step`, keeps the header and the rows up to `step` of an existing series
+/// file, and refuses (leaving it as it is) a file whose header differs from `header` (written by another granflow
+/// version): its rows would not fit the header, and dropping them would lose finished work silently. Otherwise (a
+/// run starting from its initial state) keeps no row: a run killed after writing its first row but before its first
+/// checkpoint would otherwise start with that row twice.
 fn truncate_series(path: &Path, header: &str, step: u64, resuming: bool) -> Result<()> {
     let text = match std::fs::read_to_string(path) {
         Ok(t) => t,
@@ -368,7 +370,7 @@ fn truncate_series(path: &Path, header: &str, step: u64, resuming: bool) -> Resu
         // A row cut short by a kill has fewer fields and is dropped.
         let complete = line.split(',').count() == fields;
         match line.split(',').next().and_then(|s| s.parse::<u64>().ok()) {
-            Some(s) if s <= step && complete => {
+            Some(s) if resuming && s <= step && complete => {
                 out.push_str(line);
                 out.push('\n');
             }
@@ -663,4 +665,23 @@ pub fn run_in_dir(built: &BuiltScenario, out: &Path, ctl: RunControl) -> Result<
         write_atomic(&out.join("summary.json"), json.as_bytes())?;
     }
     Ok((summary, sim))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::truncate_series;
+
+    #[test]
+    fn a_fresh_start_keeps_no_row_of_an_attempt_killed_before_its_first_checkpoint() {
+        let dir = tempfile::tempdir().expect("temp dir");
+        let path = dir.path().join("series.csv");
+        // An attempt killed after its step-0 row and before its step-0 checkpoint.
+        std::fs::write(&path, "step,time_s\n0,0e0\n").expect("write");
+        truncate_series(&path, "step,time_s", 0, false).expect("truncate");
+        assert_eq!(std::fs::read_to_string(&path).unwrap(), "step,time_s\n");
+        // Resuming from step 10 keeps the rows up to it and drops a row cut short.
+        std::fs::write(&path, "step,time_s\n0,0e0\n10,1e0\n20,2e0\n30\n").expect("write");
+        truncate_series(&path, "step,time_s", 10, true).expect("truncate");
+        assert_eq!(std::fs::read_to_string(&path).unwrap(), "step,time_s\n0,0e0\n10,1e0\n");
+    }
 }

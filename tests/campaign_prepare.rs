@@ -7,11 +7,15 @@
 mod common;
 
 use std::path::Path;
+use std::process::{Command, Stdio};
+use std::time::Duration;
 
 use common::{final_state, granflow};
 use granflow::engine::state::first_difference;
+use rand::{RngExt, SeedableRng};
 
-fn campaign(inflow_from_s: f64) -> String {
+/// The campaign: bridges and inflow from `start_s`, prepared to `until_s`, jobs ending at `end_time_s`.
+fn campaign(start_s: f64, until_s: f64, end_time_s: f64) -> String {
     format!(
         r#"
 name: prepared-bed
@@ -28,15 +32,15 @@ base:
     - lattice: {{ species: left, spacing_m: 0.003, lo_m: [0.0, 0.0015, 0.0], hi_m: [0.015, 0.0315, 0.0027], origin_m: [0.0015, 0.0015, 0.00135] }}
     - lattice: {{ species: right, spacing_m: 0.003, lo_m: [0.015, 0.0015, 0.0], hi_m: [0.03, 0.0315, 0.0027], origin_m: [0.0015, 0.0015, 0.00135] }}
   cohesion:
-    liquid_bridge: {{ surface_tension_n_per_m: 0.02, viscosity_pa_s: 0.001, bridges_from_s: 0.01 }}
+    liquid_bridge: {{ surface_tension_n_per_m: 0.02, viscosity_pa_s: 0.001, bridges_from_s: {start_s} }}
   gas:
     density_kg_per_m3: 1.23
     viscosity_pa_s: 1.8e-5
     cells: [4, 12, 1]
     sides: {{ y_low: {{ inlet: {{ superficial_velocity_m_per_s: 1.0 }} }}, y_high: outlet }}
     dem_steps_per_gas_step: 5
-    inflow_ramp: {{ start_s: {inflow_from_s}, duration_s: 0.005 }}
-  time: {{ dt_s: 2.0e-5, end_time_s: 0.03 }}
+    inflow_ramp: {{ start_s: {start_s}, duration_s: 0.005 }}
+  time: {{ dt_s: 2.0e-5, end_time_s: {end_time_s} }}
   output: {{ series_every_steps: 10 }}
 sweep:
   grid:
@@ -44,7 +48,7 @@ sweep:
     - {{ param: gas.sides.y_low.inlet.superficial_velocity_m_per_s, name: u_m_per_s, values: [0.5, 1.5] }}
 metrics: [intensity_of_segregation, pressure_drop_mean_pa]
 analysis: {{ mixing_species: left, mixing_every_steps: 100, average_from_s: 0.015 }}
-prepare: {{ until_s: 0.01, shared_across: [surface_tension_n_per_m, u_m_per_s] }}
+prepare: {{ until_s: {until_s}, shared_across: [surface_tension_n_per_m, u_m_per_s] }}
 checkpoint: {{ every_steps: 400 }}
 executor: {{ local: {{ max_parallel: 2 }} }}
 "#
@@ -64,7 +68,7 @@ fn job_dirs(out: &Path) -> Vec<std::path::PathBuf> {
 fn prepared_jobs_end_bit_identical_to_jobs_run_from_the_start() {
     let tmp = tempfile::tempdir().expect("temp dir");
     let dir = tmp.path();
-    std::fs::write(dir.join("bed.yaml"), campaign(0.01)).expect("write");
+    std::fs::write(dir.join("bed.yaml"), campaign(0.01, 0.01, 0.03)).expect("write");
     let out = granflow(&["run", "bed.yaml", "--out", "bed", "--quiet"], dir);
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
 
@@ -132,8 +136,8 @@ fn prepared_jobs_end_bit_identical_to_jobs_run_from_the_start() {
 fn a_preparation_shared_across_a_parameter_that_acts_before_its_end_fails_its_jobs() {
     let tmp = tempfile::tempdir().expect("temp dir");
     let dir = tmp.path();
-    // The inflow starts at 0.005 s, before the preparation ends: the inlet velocity acts.
-    std::fs::write(dir.join("bed.yaml"), campaign(0.005)).expect("write");
+    // The bridges and the inflow start at 0.005 s, before the preparation ends: both swept parameters act.
+    std::fs::write(dir.join("bed.yaml"), campaign(0.005, 0.01, 0.03)).expect("write");
     let out = granflow(&["run", "bed.yaml", "--out", "bed", "--quiet"], dir);
     assert!(!out.status.success());
     let status = granflow(&["status", "bed"], dir);
@@ -150,4 +154,76 @@ fn a_preparation_shared_across_a_parameter_that_acts_before_its_end_fails_its_jo
         assert!(!job.join("result.json").exists());
         assert!(!job.join("series.csv").exists(), "{}", job.display());
     }
+}
+
+/// Runs `granflow worker <dir>` and kills it with SIGKILL after `delay`, unless it finishes first.
+fn worker_killed_after(dir: &Path, delay: Duration) -> bool {
+    let mut child = Command::new(env!("CARGO_BIN_EXE_granflow"))
+        .args(["worker", dir.to_str().unwrap()])
+        .stdout(Stdio::null())
+        .stderr(Stdio::null())
+        .spawn()
+        .unwrap();
+    std::thread::sleep(delay);
+    let finished = matches!(child.try_wait(), Ok(Some(_)));
+    let _ = child.kill();
+    let _ = child.wait();
+    finished
+}
+
+#[test]
+fn a_prepared_job_killed_at_random_moments_ends_as_the_uninterrupted_one() {
+    let tmp = tempfile::tempdir().expect("temp dir");
+    let dir = tmp.path();
+    // Long enough (a 0.2 s preparation of a 0.3 s job) for kills to land while preparing, adopting and running.
+    std::fs::write(dir.join("bed.yaml"), campaign(0.2, 0.2, 0.3)).expect("write");
+    let out = granflow(&["run", "bed.yaml", "--out", "reference", "--quiet"], dir);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let reference = job_dirs(&dir.join("reference")).remove(0);
+
+    // The same job alone in a fresh campaign directory, its worker killed again and again.
+    let job = dir.join("killed/jobs").join(reference.file_name().unwrap());
+    std::fs::create_dir_all(&job).expect("job directory");
+    std::fs::copy(reference.join("job.json"), job.join("job.json")).expect("copy job");
+    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(5);
+    let mut kills = 0;
+    let mut kills_while_preparing = 0;
+    for _ in 0..60 {
+        if job.join("result.json").exists() {
+            break;
+        }
+        let preparing = !job.join("series.csv").exists();
+        if !worker_killed_after(&job, Duration::from_millis(rng.random_range(20..250))) {
+            kills += 1;
+            kills_while_preparing += usize::from(preparing);
+        }
+    }
+    for _ in 0..5 {
+        if job.join("result.json").exists() {
+            break;
+        }
+        worker_killed_after(&job, Duration::from_secs(60));
+    }
+    assert!(
+        job.join("result.json").exists(),
+        "the job did not finish: {}",
+        std::fs::read_to_string(job.join("worker.log")).unwrap_or_default()
+    );
+    assert!(
+        kills >= 5 && kills_while_preparing >= 2,
+        "{kills} kills, {kills_while_preparing} while preparing: make the job longer"
+    );
+    eprintln!("{kills} kills, {kills_while_preparing} while preparing");
+    let metrics = |d: &Path| -> serde_json::Value {
+        let text = std::fs::read_to_string(d.join("result.json")).expect("result");
+        serde_json::from_str::<serde_json::Value>(&text).expect("json")["metrics"].clone()
+    };
+    assert_eq!(metrics(&job), metrics(&reference), "metrics after {kills} kills");
+    assert_eq!(
+        first_difference(&final_state(&job), &final_state(&reference)),
+        None,
+        "final states after {kills} kills"
+    );
+    let series = |d: &Path| std::fs::read_to_string(d.join("series.csv")).expect("series");
+    assert_eq!(series(&job), series(&reference), "series after {kills} kills");
 }
