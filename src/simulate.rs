@@ -311,7 +311,10 @@ pub fn attach_gas(
             match restored {
                 Some(snap) => sim.restore_gas(snap).map_err(Error::External),
                 // A checkpoint of a gas run always holds the gas; only a new run starts without one.
-                None => Ok(()),
+                None => {
+                    sim.start_drying_ledger();
+                    Ok(())
+                }
             }
         }
     }

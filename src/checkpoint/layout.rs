@@ -35,6 +35,9 @@ use crate::engine::state::{RngState, SimState};
 /// The name of the gas temperature among the gas's transported scalars.
 const GAS_TEMPERATURE: &str = "temperature_k";
 
+/// The name of the vapour among the gas's transported scalars (a run with drying).
+const GAS_VAPOUR: &str = crate::engine::drying::VAPOUR_FIELD;
+
 /// Value of the root attribute `format`.
 pub(crate) const FORMAT_NAME: &str = "granflow-checkpoint";
 
@@ -69,6 +72,10 @@ pub(crate) enum Rows {
     GasCellsIfHeat,
     /// One value when the gas carries a temperature, none otherwise.
     GasScalarIfHeat,
+    /// The number of gas cells when the gas carries vapour (a run with drying), 0 otherwise.
+    GasCellsIfDrying,
+    /// One value when the gas carries vapour, none otherwise.
+    GasScalarIfDrying,
 }
 
 /// One dataset of the layout.
@@ -386,6 +393,13 @@ datasets! {
     gas_temperature_k: f64 => "gas/temperature_k", Rows::GasCellsIfHeat, 1, "K";
     gas_heat_transfer_sum: f64 => "gas/heat_transfer_sum_k_kg_per_m3_s", Rows::GasCellsIfHeat, 1, "K kg/(m3 s)";
     gas_heat_exchange_steps: u32 => "gas/heat_exchange_steps", Rows::GasScalarIfHeat, 1, "1";
+    gas_vapour_mass_fraction: f64 => "gas/vapour_mass_fraction", Rows::GasCellsIfDrying, 1, "kg/kg";
+    drying_initial_liquid_kg: f64 => "gas/drying/initial_liquid_kg", Rows::GasScalarIfDrying, 1, "kg";
+    drying_initial_vapour_kg: f64 => "gas/drying/initial_vapour_kg", Rows::GasScalarIfDrying, 1, "kg";
+    drying_sprayed_kg: f64 => "gas/drying/sprayed_kg", Rows::GasScalarIfDrying, 1, "kg";
+    drying_evaporated_kg: f64 => "gas/drying/evaporated_kg", Rows::GasScalarIfDrying, 1, "kg";
+    drying_vapour_in_kg: f64 => "gas/drying/vapour_in_kg", Rows::GasScalarIfDrying, 1, "kg";
+    drying_vapour_out_kg: f64 => "gas/drying/vapour_out_kg", Rows::GasScalarIfDrying, 1, "kg";
     held_drag_position_m: f64 => "gas/held_drag/position_m", Rows::ParticlesIfRecorded, 3, "m";
     held_drag_velocity: f64 => "gas/held_drag/velocity_m_per_s", Rows::ParticlesIfRecorded, 3, "m/s";
     held_drag_velocity_sum: f64 => "gas/held_drag/velocity_sum_m_per_s", Rows::ParticlesIfRecorded, 3, "m/s";
@@ -411,6 +425,7 @@ pub(crate) const GROUPS: &[&str] = &[
     "gas",
     "gas/last_step",
     "gas/held_drag",
+    "gas/drying",
     "net_force",
     "particles/channels",
 ];
@@ -441,6 +456,9 @@ impl Arrays {
         // The one transported scalar a checkpoint holds today: the gas temperature of a run with heat transfer.
         let gas_temperature = gas.and_then(|g| g.scalars.iter().find(|s| s.name == GAS_TEMPERATURE));
         let held = gas.and_then(|g| g.held_drag.as_ref());
+        let vapour = gas.and_then(|g| g.scalars.iter().find(|s| s.name == GAS_VAPOUR));
+        let ledger = gas.and_then(|g| g.drying.as_ref());
+        let ledger_value = |f: fn(&crate::engine::drying::DryingLedger) -> f64| ledger.map(f).into_iter().collect();
         Arrays {
             particle_id: p.id.iter().map(|id| id.0).collect(),
             particle_species: p.species.iter().map(|s| s.0).collect(),
@@ -503,6 +521,13 @@ impl Arrays {
                 .map(|s| s.exchange.transfer_sum.clone())
                 .unwrap_or_default(),
             gas_heat_exchange_steps: gas_temperature.map(|s| s.exchange.steps).into_iter().collect(),
+            gas_vapour_mass_fraction: vapour.map(|s| s.value.clone()).unwrap_or_default(),
+            drying_initial_liquid_kg: ledger_value(|l| l.initial_liquid_kg),
+            drying_initial_vapour_kg: ledger_value(|l| l.initial_vapour_kg),
+            drying_sprayed_kg: ledger_value(|l| l.sprayed_kg),
+            drying_evaporated_kg: ledger_value(|l| l.evaporated_kg),
+            drying_vapour_in_kg: ledger_value(|l| l.vapour_in_kg),
+            drying_vapour_out_kg: ledger_value(|l| l.vapour_out_kg),
             held_drag_position_m: held.map(|h| flatten(&h.position_m)).unwrap_or_default(),
             held_drag_velocity: held.map(|h| flatten(&h.velocity_m_per_s)).unwrap_or_default(),
             held_drag_velocity_sum: held.map(|h| flatten(&h.velocity_sum_m_per_s)).unwrap_or_default(),
@@ -598,6 +623,24 @@ impl Arrays {
                  /gas/heat_exchange_steps {}, expected one per gas cell ({gas_cells}) and one",
                 self.gas_heat_transfer_sum.len(),
                 self.gas_heat_exchange_steps.len()
+            ));
+        }
+        let vapour_cells = self.gas_vapour_mass_fraction.len();
+        let ledger = [
+            self.drying_initial_liquid_kg.len(),
+            self.drying_initial_vapour_kg.len(),
+            self.drying_sprayed_kg.len(),
+            self.drying_evaporated_kg.len(),
+            self.drying_vapour_in_kg.len(),
+            self.drying_vapour_out_kg.len(),
+        ];
+        let drying = vapour_cells != 0;
+        if (drying && (vapour_cells != gas_cells || heat_cells != gas_cells))
+            || ledger.iter().any(|&len| len != usize::from(drying))
+        {
+            return Err(format!(
+                "/gas/vapour_mass_fraction has {vapour_cells} values and the /gas/drying datasets {ledger:?}, \
+                 expected none, or one per gas cell ({gas_cells}, with a gas temperature) and one each"
             ));
         }
         let optional = CHANNELS
@@ -720,7 +763,21 @@ impl Arrays {
                     },
                 })
                 .into_iter()
+                .chain((self.gas_vapour_mass_fraction.len() == cells && cells > 0).then(|| GasScalarSnapshot {
+                    name: GAS_VAPOUR.into(),
+                    unit: "kg/kg".into(),
+                    value: self.gas_vapour_mass_fraction,
+                    exchange: ExchangeAccumulator::new(cells),
+                }))
                 .collect(),
+            drying: (self.drying_evaporated_kg.len() == 1).then(|| crate::engine::drying::DryingLedger {
+                initial_liquid_kg: self.drying_initial_liquid_kg[0],
+                initial_vapour_kg: self.drying_initial_vapour_kg[0],
+                sprayed_kg: self.drying_sprayed_kg[0],
+                evaporated_kg: self.drying_evaporated_kg[0],
+                vapour_in_kg: self.drying_vapour_in_kg[0],
+                vapour_out_kg: self.drying_vapour_out_kg[0],
+            }),
         });
         let net_force = (self.net_force_steps.len() == 1).then(|| NetForceTally {
             steps: self.net_force_steps[0],
@@ -766,7 +823,11 @@ impl Visitor for ShapeCheck {
             )),
             Rows::Scalar | Rows::Fixed(_) => Ok(()),
             // Each of these is 0 or N rows on its own ([`Arrays::check`]).
-            Rows::ParticlesIfRecorded | Rows::GasCellsIfHeat | Rows::GasScalarIfHeat => Ok(()),
+            Rows::ParticlesIfRecorded
+            | Rows::GasCellsIfHeat
+            | Rows::GasScalarIfHeat
+            | Rows::GasCellsIfDrying
+            | Rows::GasScalarIfDrying => Ok(()),
             _ if !len.is_multiple_of(spec.width) => Err(format!(
                 "/{} has {len} elements, not a multiple of {}",
                 spec.path, spec.width

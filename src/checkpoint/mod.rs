@@ -31,7 +31,7 @@ use crate::engine::SimState;
 
 /// Version of the file layout. Bump it whenever a name, type, shape or the checksum definition changes; readers
 /// reject any other version with [`CheckpointError::Version`].
-pub const CHECKPOINT_FORMAT_VERSION: u32 = 8;
+pub const CHECKPOINT_FORMAT_VERSION: u32 = 9;
 
 /// Metadata stored beside the state.
 #[derive(Debug, Clone, PartialEq)]
@@ -415,6 +415,8 @@ fn expected_shape(spec: &DatasetSpec) -> String {
         Rows::ParticlesIfRecorded => "0 or N".to_string(),
         Rows::GasCellsIfHeat => "0 or gas cells".to_string(),
         Rows::GasScalarIfHeat => "0 or 1".to_string(),
+        Rows::GasCellsIfDrying => "0 or gas cells".to_string(),
+        Rows::GasScalarIfDrying => "0 or 1".to_string(),
     };
     if spec.width == 1 {
         format!("[{rows}]")

@@ -55,6 +55,12 @@ struct Watch {
 const WALL_SLOT: u32 = 1 << 31;
 
 impl BridgeCache {
+    /// Makes the next liquid step examine every slot (and refresh every bridge's constants): the bridges' volumes
+    /// changed outside it (evaporation).
+    pub fn forget_watch(&mut self) {
+        self.watch.drift_bound_at_pass_m = None;
+    }
+
     /// Sized for `list`, every entry unset, when it is not already.
     fn fit(&mut self, list: &NeighborList) {
         if self.pair.len() != list.partner.len() {

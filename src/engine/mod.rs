@@ -6,6 +6,7 @@ pub mod channels;
 pub mod cohesion;
 pub mod config;
 pub mod contacts;
+pub mod drying;
 pub mod error;
 pub mod gas;
 pub mod geometry;

@@ -46,6 +46,8 @@ pub struct StageTimers {
     pub fluid_forces: Duration,
     /// The liquid inventory's events (inside `force`).
     pub liquid: Duration,
+    /// Drying steps: evaporation and the vapour's solves (inside `gas`).
+    pub drying: Duration,
 }
 
 /// The simulation's workspace: what it keeps between steps only to go fast, none of it state (a simulation restored
@@ -390,6 +392,10 @@ impl Simulation {
 
     /// Attaches a gas (a coupled run); a restored run then restores the gas state with [`Self::restore_gas`].
     pub fn attach_gas(&mut self, gas: GasCoupling) {
+        if gas.drying.is_some() {
+            // Condensation may wet a dry bed.
+            self.work.cohesion_inert = false;
+        }
         self.gas = Some(Box::new(gas));
     }
 
@@ -405,9 +411,29 @@ impl Simulation {
         let t = Instant::now();
         let gas = self.gas.as_mut().expect("called only with a gas");
         let dt_gas = self.dt_s * gas.dem_steps_per_gas_step as f64;
-        let result = gas.advance(dt_gas, &self.particles.position_m, &self.particles.radius_m);
+        let mut result = gas
+            .advance(dt_gas, &self.particles.position_m, &self.particles.radius_m)
+            .map(|_| ());
+        if result.is_ok()
+            && gas.drying.is_some()
+            && let Some(heat) = self.config.heat.as_ref()
+        {
+            let t = Instant::now();
+            result = super::drying::dry(
+                gas,
+                &mut self.particles,
+                &heat.heat_capacity_j_per_kg_k,
+                &self.work.list,
+                &mut self.history,
+                dt_gas,
+            )
+            .map(|_| ());
+            // The bridges' volumes changed: the next liquid step examines every slot and refreshes their constants.
+            self.work.bridges.forget_watch();
+            self.timers.drying += t.elapsed();
+        }
         self.timers.gas += t.elapsed();
-        result.map(|_| ()).map_err(|detail| NumericalError::GasDiverged {
+        result.map_err(|detail| NumericalError::GasDiverged {
             step: self.step,
             detail,
         })
@@ -633,6 +659,11 @@ impl Simulation {
             config.inner_skin_m,
         );
         self.sprayed_m3 += events.sprayed_m3;
+        if events.sprayed_m3 > 0.0
+            && let Some(drying) = self.gas.as_mut().and_then(|g| g.drying.as_mut())
+        {
+            drying.ledger.sprayed_kg += events.sprayed_m3 * drying.config.liquid_density_kg_per_m3;
+        }
         self.cohesion_events.bridges_formed += events.bridges_formed;
         self.cohesion_events.bridges_ruptured += events.bridges_ruptured;
         self.timers.liquid += t.elapsed();
@@ -644,6 +675,34 @@ impl Simulation {
         if self.net_force.is_none() {
             self.net_force = Some(NetForceTally::new(self.config.walls.len()));
         }
+    }
+
+    /// Records the present liquid and vapour as the drying ledger's start (a new run with drying, once its gas is
+    /// attached; a restored run keeps its checkpointed ledger).
+    pub fn start_drying_ledger(&mut self) {
+        let liquid_m3 = self.total_liquid_m3();
+        if let Some(gas) = self.gas.as_mut() {
+            let vapour_kg = gas.vapour_kg();
+            if let (Some(drying), Some(vapour_kg)) = (gas.drying.as_mut(), vapour_kg) {
+                drying.ledger = super::drying::DryingLedger {
+                    initial_liquid_kg: liquid_m3 * drying.config.liquid_density_kg_per_m3,
+                    initial_vapour_kg: vapour_kg,
+                    ..Default::default()
+                };
+            }
+        }
+    }
+
+    /// The drying ledger's closure: (liquid + vapour in the gas + vapour gone out − vapour come in) over (the
+    /// start's liquid and vapour + sprayed), minus 1 (`None` without drying).
+    pub fn drying_closure(&self) -> Option<f64> {
+        let gas = self.gas.as_ref()?;
+        let drying = gas.drying.as_ref()?;
+        let l = &drying.ledger;
+        let liquid_kg = self.total_liquid_m3() * drying.config.liquid_density_kg_per_m3;
+        let now = liquid_kg + gas.vapour_kg()? + l.vapour_out_kg - l.vapour_in_kg;
+        let start = l.initial_liquid_kg + l.initial_vapour_kg + l.sprayed_kg;
+        Some(now / start - 1.0)
     }
 
     /// Liquid on the particles plus liquid in bridges, m³.

@@ -272,6 +272,7 @@ pub fn build(spec: ScenarioSpec, path: &Path) -> Result<BuiltScenario, ConfigErr
     if let Some(g) = gas.as_mut() {
         super::heat::build_gas_heat(path, &spec, g)?;
     }
+    super::drying::build_drying(path, &spec, gas.as_mut())?;
     let wall_species: Vec<_> = walls.iter().map(|w| w.species).collect();
     let mut cohesion = match spec.cohesion {
         None => None,

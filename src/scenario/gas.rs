@@ -256,6 +256,8 @@ pub struct GasSetup {
     pub jet_face_ends: Vec<usize>,
     /// The gas's energy and convection, in a run with heat transfer (set by `scenario/heat.rs`).
     pub heat: Option<(GasThermal, GasScalarSpec)>,
+    /// Evaporation and the vapour field, in a run with drying (set by `scenario/drying.rs`).
+    pub drying: Option<(crate::engine::drying::DryingConfig, GasScalarSpec)>,
 }
 
 impl GasSetup {
@@ -275,6 +277,9 @@ impl GasSetup {
         coupling.fluid.drag_update = self.drag_update;
         if let Some((thermal, spec)) = &self.heat {
             coupling.attach_heat(*thermal, spec.clone())?;
+        }
+        if let Some((config, spec)) = &self.drying {
+            coupling.attach_drying(*config, spec.clone())?;
         }
         Ok(coupling)
     }
@@ -619,5 +624,6 @@ pub fn build_gas(
         pressure_probe_height_m: spec.pressure_probe_height_m,
         jet_face_ends,
         heat: None,
+        drying: None,
     })
 }

@@ -5,6 +5,7 @@
 //! mean" of unknown keys (`crate::util::did_you_mean`).
 
 mod build;
+pub mod drying;
 pub mod gas;
 mod heat;
 mod locate;

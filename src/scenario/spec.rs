@@ -52,6 +52,10 @@ pub struct ScenarioSpec {
     /// Heat transfer: particle temperatures and conduction; absent: none.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub heat: Option<HeatSpec>,
+    /// Drying (seed 000 chapter 7): the particles' liquid evaporates into the gas, which carries the vapour;
+    /// needs `heat` and a `gas` (not in vacuum); absent: nothing evaporates.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub drying: Option<super::drying::DryingSpec>,
 }
 
 /// A particle material as the scenario writes it (`build.rs` turns it into the engine's `Species`). Walls are

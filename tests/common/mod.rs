@@ -114,6 +114,7 @@ pub fn with_gas(b: &BuiltScenario) -> Simulation {
         let p = &sim.particles;
         let gas = setup.coupling(&p.position_m, &p.radius_m).expect("the gas builds");
         sim.attach_gas(gas);
+        sim.start_drying_ledger();
     }
     sim
 }

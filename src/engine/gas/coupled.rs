@@ -56,6 +56,8 @@ pub struct GasSnapshot {
     /// The transported scalars in their declaration order; empty when none is declared (the checkpoint then has
     /// nothing more to hold).
     pub scalars: Vec<GasScalarSnapshot>,
+    /// The drying ledger of a gas with drying (its vapour is among `scalars`).
+    pub drying: Option<crate::engine::drying::DryingLedger>,
 }
 
 /// A transported scalar's checkpointed state: its field and the exchange accumulated since the last gas step.
@@ -112,6 +114,11 @@ pub struct GasCoupling {
     pub(crate) scalars: Vec<TransportedScalar>,
     /// The gas's energy and its convection with the particles (`heat.rs`); `None`: no temperature.
     pub heat: Option<super::heat::GasHeat>,
+    /// Evaporation and the vapour it carries (`engine::drying`); `None`: nothing evaporates.
+    pub drying: Option<crate::engine::drying::GasDrying>,
+    /// With drying, the porosity before and the mass flows of the gas step just taken, for the drying step that
+    /// follows it (workspace).
+    pub(crate) step_flows: Option<(Vec<f64>, [Vec<f64>; 3])>,
 }
 
 impl GasCoupling {
@@ -158,6 +165,8 @@ impl GasCoupling {
             linear_solve_s: 0.0,
             scalars: Vec::new(),
             heat: None,
+            drying: None,
+            step_flows: None,
         })
     }
 
@@ -256,10 +265,17 @@ impl GasCoupling {
         if !self.scalars.is_empty() {
             let mass_flow = self.solver.mass_flow_kg_per_s();
             for scalar in &mut self.scalars {
+                if scalar.spec.exchange == super::transported_scalar::ScalarExchange::Evaporation {
+                    // Stepped by the drying step, with the particles.
+                    continue;
+                }
                 let t = std::time::Instant::now();
                 let r = scalar.step(&self.solver, &old_porosity, &mass_flow, dt_s)?;
                 self.linear_solve_s += t.elapsed().as_secs_f64();
                 linear_iterations += r.iterations as u64;
+            }
+            if self.drying.is_some() {
+                self.step_flows = Some((old_porosity, mass_flow));
             }
         }
         let state = &self.solver.state;
@@ -312,6 +328,7 @@ impl GasCoupling {
                     exchange: s.exchange.clone(),
                 })
                 .collect(),
+            drying: self.drying.as_ref().map(|d| d.ledger),
         }
     }
 
@@ -396,6 +413,12 @@ impl GasCoupling {
                 );
             }
             _ => {}
+        }
+        match (self.drying.as_mut(), &snap.drying) {
+            (Some(drying), Some(ledger)) => drying.ledger = *ledger,
+            (None, None) => {}
+            (Some(_), None) => return Err("the scenario dries but the checkpoint's gas holds no drying ledger".into()),
+            (None, Some(_)) => return Err("the checkpoint's gas holds a drying ledger but the scenario does not dry".into()),
         }
         self.last = snap.last;
         Ok(())

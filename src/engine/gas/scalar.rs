@@ -57,6 +57,19 @@ pub struct ScalarEquation<'a> {
     pub exchange_coefficient: &'a [f64],
     /// K φ_p per unit volume at each cell, (unit of φ)·kg/(m³·s); empty for none.
     pub exchange_coefficient_value: &'a [f64],
+    /// The plainly conservative form instead of Patankar's: a_P gains the cell's continuity residual
+    /// r_P = ρ(ε − ε⁰)V/Δt + Σ F_out, so the scalar's content changes by exactly what crosses the boundary plus the
+    /// sources (to the linear solve's residual), whatever the mass flows' imbalance (a vapour's mass ledger).
+    pub conservative: bool,
+}
+
+/// What crossed the boundary of the gas over one step, per unit time, in (unit of φ)·kg/s.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct BoundaryFlows {
+    /// Into the gas through faces where it enters (inlets, jets, diffusion from a held value).
+    pub in_per_s: f64,
+    /// Out of the gas through faces where it leaves (outlets, diffusion into a held value).
+    pub out_per_s: f64,
 }
 
 /// The neighbouring cell across the face on the `high` side of `idx` along `axis` (wrapped on a periodic axis), or
@@ -110,6 +123,8 @@ impl ScalarEquation<'_> {
                         continue;
                     }
                     let (mut ap, mut b, mut slot) = (0.0, 0.0, 0);
+                    // Σ of the mass flows into the cell over its faces (the conservative form's residual).
+                    let mut net_inflow = 0.0;
                     for a in 0..grid.axes() {
                         let area = grid.face_area_m2(a);
                         for high in [false, true] {
@@ -117,6 +132,7 @@ impl ScalarEquation<'_> {
                             fi[a] += usize::from(high);
                             let face = grid.face(a, fi);
                             let flow_into = if high { -1.0 } else { 1.0 } * self.mass_flow_kg_per_s[a][face];
+                            net_inflow += flow_into;
                             match neighbour(grid, idx, a, high) {
                                 Some(nb) => {
                                     let q = grid.cell(nb);
@@ -150,6 +166,9 @@ impl ScalarEquation<'_> {
                     let a_p0 = rho * self.old_porosity[p] * volume / dt_s;
                     let exchange = per_cell(self.exchange_coefficient, p) * volume;
                     sys.ap[p] = ap + a_p0 + exchange;
+                    if self.conservative {
+                        sys.ap[p] += rho * (eps[p] - self.old_porosity[p]) * volume / dt_s - net_inflow;
+                    }
                     sys.b[p] = b
                         + a_p0 * old[p]
                         + per_cell(self.exchange_coefficient_value, p) * volume
@@ -158,6 +177,72 @@ impl ScalarEquation<'_> {
             }
         }
         sys
+    }
+
+    /// What crosses the gas's boundary per unit time with φ at the end of the step (the conservative form's
+    /// fluxes, Patankar 1980 §5.7: through a face into a cell, a_b (φ_b − φ_P) + F_in φ_P where the face gives a
+    /// value φ_b, F_in φ_P where it does not; faces to blocked cells carry no mass, and diffusion into a held value
+    /// there is a_b (φ_b − φ_P)). Periodic faces are interior.
+    pub fn boundary_flows(&self, phi: &[f64]) -> BoundaryFlows {
+        let grid = self.grid;
+        let gamma = self.diffusion_kg_per_m_s;
+        let eps = self.porosity;
+        let mut flows = BoundaryFlows::default();
+        let mut add = |flux: f64| {
+            if flux >= 0.0 {
+                flows.in_per_s += flux;
+            } else {
+                flows.out_per_s -= flux;
+            }
+        };
+        for k in 0..grid.n[2] {
+            for j in 0..grid.n[1] {
+                for i in 0..grid.n[0] {
+                    let idx = [i, j, k];
+                    let p = grid.cell(idx);
+                    if self.is_blocked(p) {
+                        continue;
+                    }
+                    for a in 0..grid.axes() {
+                        let area = grid.face_area_m2(a);
+                        for high in [false, true] {
+                            let mut fi = idx;
+                            fi[a] += usize::from(high);
+                            let face = grid.face(a, fi);
+                            let flow_into = if high { -1.0 } else { 1.0 } * self.mass_flow_kg_per_s[a][face];
+                            match neighbour(grid, idx, a, high) {
+                                Some(nb) => {
+                                    if self.is_blocked(grid.cell(nb))
+                                        && let Some(value) = self.blocked_value
+                                    {
+                                        let diffusion = gamma * eps[p] * area / (0.5 * grid.h_m[a]);
+                                        add(self.neighbour_coefficient(0.0, diffusion) * (value - phi[p]));
+                                    }
+                                }
+                                None => {
+                                    let held = self.boundary_value[a][face].map_or(0.0, |value| {
+                                        let diffusion = gamma * eps[p] * area / (0.5 * grid.h_m[a]);
+                                        self.neighbour_coefficient(flow_into, diffusion) * (value - phi[p])
+                                    });
+                                    add(held + flow_into * phi[p]);
+                                }
+                            }
+                        }
+                    }
+                }
+            }
+        }
+        flows
+    }
+
+    /// The scalar's content Σ ε ρ φ V over the cells outside blocked ones (porosity at the end of the step), in
+    /// (unit of φ)·kg.
+    pub fn content(&self, phi: &[f64]) -> f64 {
+        let volume = self.grid.cell_volume_m3();
+        (0..phi.len())
+            .filter(|&c| !self.is_blocked(c))
+            .map(|c| self.porosity[c] * self.density_kg_per_m3 * phi[c] * volume)
+            .sum()
     }
 
     /// Advances φ by `dt_s` in place (φ holds the step's start on entry).
@@ -260,6 +345,7 @@ pub fn step_scalar(problem: &ScalarProblem, phi: &mut [f64], dt_s: f64, toleranc
         source: problem.source,
         exchange_coefficient: &[],
         exchange_coefficient_value: &[],
+        conservative: false,
     }
     .step(phi, dt_s, tolerance, 10_000)
 }

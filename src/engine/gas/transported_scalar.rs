@@ -29,6 +29,9 @@ pub enum ScalarExchange {
     /// The mean transfer the particles computed under the frozen field, as an explicit source (exactly the
     /// opposite of what the particles received; stable while the gas step is short against ε ρ / Σk).
     Explicit,
+    /// Evaporation: the drying step (`engine::drying`) fills the exchange at the gas step, implicitly in the
+    /// scalar and the particles' temperatures, and steps the scalar itself, in the conservative form.
+    Evaporation,
 }
 
 /// A scalar's condition on a wall side.
@@ -173,27 +176,23 @@ impl TransportedScalar {
         solver.state.time_s >= self.spec.fixed_from_s
     }
 
-    /// Advances φ over the gas step of `dt_s` that `solver` has just taken from porosity `old_porosity`, with the
-    /// mean particle exchange of the accumulator (which is then cleared for the next sub-steps). Returns the
-    /// linear solve's report, or an error naming the field when the solve fails or φ stops being finite.
-    pub fn step(
-        &mut self,
-        solver: &GasSolver,
-        old_porosity: &[f64],
-        mass_flow_kg_per_s: &[Vec<f64>; 3],
-        dt_s: f64,
-    ) -> Result<SolveReport, String> {
+    /// The discretised equation of a step of this scalar over the gas step `solver` has just taken from porosity
+    /// `old_porosity`, with the given exchange (per cell: K and K φ_p per unit volume, empty for none) and explicit
+    /// source; `boundary_value` from [`Self::boundary_values`].
+    #[allow(clippy::too_many_arguments)]
+    pub fn equation<'a>(
+        &'a self,
+        solver: &'a GasSolver,
+        old_porosity: &'a [f64],
+        mass_flow_kg_per_s: &'a [Vec<f64>; 3],
+        boundary_value: &'a [Vec<Option<f64>>; 3],
+        exchange_coefficient: &'a [f64],
+        exchange_coefficient_value: &'a [f64],
+        source: &'a [f64],
+        conservative: bool,
+    ) -> ScalarEquation<'a> {
         let config = &solver.config;
-        let boundary_value = self.boundary_values(solver);
-        let (coefficient, coefficient_value, source) = match self.spec.exchange {
-            ScalarExchange::Implicit => (
-                self.exchange.mean_coefficient(),
-                self.exchange.mean_coefficient_value(),
-                Vec::new(),
-            ),
-            ScalarExchange::Explicit => (Vec::new(), Vec::new(), self.exchange.mean_transfer()),
-        };
-        let equation = ScalarEquation {
+        ScalarEquation {
             grid: &config.grid,
             convection: config.convection,
             density_kg_per_m3: config.density_kg_per_m3,
@@ -201,15 +200,27 @@ impl TransportedScalar {
             mass_flow_kg_per_s,
             porosity: &solver.state.porosity,
             old_porosity,
-            boundary_value: &boundary_value,
+            boundary_value,
             blocked: &config.blocked,
             blocked_value: self.spec.blocked_value.filter(|_| self.fixed_active(solver)),
-            source: &source,
-            exchange_coefficient: &coefficient,
-            exchange_coefficient_value: &coefficient_value,
-        };
+            source,
+            exchange_coefficient,
+            exchange_coefficient_value,
+            conservative,
+        }
+    }
+
+    /// φ after one step of `equation` from the present value, solved to relative residual `tolerance`, or an error
+    /// naming the field when the solve fails or φ stops being finite (the field itself is not changed).
+    pub fn solve(
+        &self,
+        equation: &ScalarEquation,
+        dt_s: f64,
+        tolerance: f64,
+        max_iterations: usize,
+    ) -> Result<(Vec<f64>, SolveReport), String> {
         let mut phi = self.value.clone();
-        let report = equation.step(&mut phi, dt_s, config.linear_tolerance, config.max_linear_iterations);
+        let report = equation.step(&mut phi, dt_s, tolerance, max_iterations);
         let name = self.spec.name;
         if let Some(k) = phi.iter().position(|v| !v.is_finite()) {
             return Err(format!("gas scalar {name} of cell {k} is not finite"));
@@ -220,6 +231,46 @@ impl TransportedScalar {
                 report.relative_residual, report.iterations
             ));
         }
+        Ok((phi, report))
+    }
+
+    /// Advances φ over the gas step of `dt_s` that `solver` has just taken from porosity `old_porosity`, with the
+    /// mean particle exchange of the accumulator (which is then cleared for the next sub-steps). Returns the
+    /// linear solve's report, or an error naming the field when the solve fails or φ stops being finite.
+    pub fn step(
+        &mut self,
+        solver: &GasSolver,
+        old_porosity: &[f64],
+        mass_flow_kg_per_s: &[Vec<f64>; 3],
+        dt_s: f64,
+    ) -> Result<SolveReport, String> {
+        let boundary_value = self.boundary_values(solver);
+        let (coefficient, coefficient_value, source) = match self.spec.exchange {
+            ScalarExchange::Implicit => (
+                self.exchange.mean_coefficient(),
+                self.exchange.mean_coefficient_value(),
+                Vec::new(),
+            ),
+            ScalarExchange::Explicit => (Vec::new(), Vec::new(), self.exchange.mean_transfer()),
+            ScalarExchange::Evaporation => {
+                return Err(format!(
+                    "gas scalar {}: stepped by the drying step, not with the other scalars",
+                    self.spec.name
+                ));
+            }
+        };
+        let equation = self.equation(
+            solver,
+            old_porosity,
+            mass_flow_kg_per_s,
+            &boundary_value,
+            &coefficient,
+            &coefficient_value,
+            &source,
+            false,
+        );
+        let config = &solver.config;
+        let (phi, report) = self.solve(&equation, dt_s, config.linear_tolerance, config.max_linear_iterations)?;
         self.value = phi;
         self.exchange.clear();
         Ok(report)

@@ -11,6 +11,7 @@ pub mod conduction;
 pub mod contact_law;
 pub mod convection;
 pub mod drag;
+pub mod evaporation;
 pub mod gas_lens;
 pub mod history;
 pub mod liquid_transfer;
