@@ -106,6 +106,12 @@ heat (optional: particle temperatures and conduction, seed 000 chapter 5):
     nusselt: seed000: { coefficient? } (default, 1.8)                    eqs. 5.6-5.7
              ranz_marshall                                               Nu = 2 + 0.6 Re^1/2 Pr^1/3
              gunn                                                        Gunn (1978), beds
+drying (optional, with heat and a gas: evaporation, seed 000 chapter 7):
+     { evaporation_coefficient, latent_heat_j_per_kg?,                   m = α π d² (p_sat(T) - p_v) √(M/(2πRT))
+       liquid_density_kg_per_m3?, initial_relative_humidity?,            (eq. 7.2), p_sat water's (eq. 7.4), from
+       inlet_relative_humidity? }                                        film and bridge shares; vapour a gas
+                                                                         scalar (eqs. 7.5-7.6); latent heat
+                                                                         (eq. 7.12); defaults: water, dry gas
 gas (optional: a gas coupled to the particles, fluidized beds):
      { vacuum?, density_kg_per_m3, viscosity_pa_s, cells: [nx, ny, nz], dem_steps_per_gas_step, sides?, jets?, blocked?,
        outside_drum?,

@@ -196,6 +196,34 @@ fn heat_columns(sim: &Simulation) -> String {
     format!(",{mean:e},{lo:e},{hi:e}")
 }
 
+/// The drying columns of a run with `drying`: the liquid on particles and in bridges (and in bridges alone), kg; the
+/// moisture content X (that liquid over the particles' dry mass, kg/kg); the vapour in the gas, gone out through
+/// its boundary and evaporated since the start, kg; the gas's mean relative humidity; and the ledger's closure
+/// ([`Simulation::drying_closure`]).
+const DRYING_SERIES_COLUMNS: &str =
+    ",liquid_kg,bridge_liquid_kg,moisture_content,vapour_kg,vapour_out_kg,evaporated_kg,gas_relative_humidity,drying_closure";
+
+/// The [`DRYING_SERIES_COLUMNS`], empty without drying.
+fn drying_columns(sim: &Simulation) -> String {
+    let Some((gas, drying)) = sim.gas.as_ref().and_then(|g| Some((g, g.drying.as_ref()?))) else {
+        return String::new();
+    };
+    let density = drying.config.liquid_density_kg_per_m3;
+    let liquid_kg = sim.total_liquid_m3() * density;
+    let bridge_kg = (sim.total_liquid_m3() - sim.particles.liquid_m3.iter().sum::<f64>()) * density;
+    let solid_kg: f64 = sim.particles.mass_kg.iter().sum();
+    let l = &drying.ledger;
+    format!(
+        ",{liquid_kg:e},{bridge_kg:e},{:e},{:e},{:e},{:e},{:e},{:e}",
+        liquid_kg / solid_kg,
+        gas.vapour_kg().unwrap_or(f64::NAN),
+        l.vapour_out_kg,
+        l.evaporated_kg,
+        gas.mean_relative_humidity().unwrap_or(f64::NAN),
+        sim.drying_closure().unwrap_or(f64::NAN)
+    )
+}
+
 /// The series header of a scenario (before any observer columns).
 pub fn series_header(built: &BuiltScenario) -> String {
     let mut header = SERIES_HEADER.to_string();
@@ -207,6 +235,9 @@ pub fn series_header(built: &BuiltScenario) -> String {
     }
     if crate::heated_drum::heated_drum(&built.config).is_some() {
         header.push_str(crate::heated_drum::DRUM_HEAT_COLUMNS);
+    }
+    if built.gas.as_ref().is_some_and(|g| g.drying.is_some()) {
+        header.push_str(DRYING_SERIES_COLUMNS);
     }
     if built.spec.output.net_forces {
         header.push_str(",weight_n,fluid_force_up_n");
@@ -334,6 +365,7 @@ fn series_row(sim: &mut Simulation, built: &BuiltScenario) -> String {
             spec.bed_core_radius_fraction,
         ));
     }
+    heat.push_str(&drying_columns(sim));
     format!(
         "{},{:e},{:e},{:e},{:e},{:e},{},{},{:.6}{gas}{heat}{net}",
         sim.step,

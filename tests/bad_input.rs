@@ -398,6 +398,53 @@ const HEAT_CASES: &[(&str, &str, &str, &[&str])] = &[
     ),
 ];
 
+/// A scenario that dries (wet beads in a closed box of gas, heat transfer on), and its bad variants.
+const GOOD_DRYING: &str = r#"
+name: ok-drying
+domain: { lo_m: [0.0, 0.0, 0.0], hi_m: [0.012, 0.012, 0.012] }
+gravity: { vector_m_per_s2: [0.0, -9.81, 0.0] }
+species:
+  - { name: glass, radius_m: 0.001, density_kg_per_m3: 2500.0, youngs_modulus_pa: 1.0e7, poisson_ratio: 0.3, friction_coefficient: 0.3, thermal_conductivity_w_per_m_k: 1.0, heat_capacity_j_per_kg_k: 800.0, liquid_content: 0.02 }
+contact: { normal: { hertz: { restitution: 0.9 } }, tangential: mindlin }
+cohesion: { liquid_bridge: { surface_tension_n_per_m: 0.072 } }
+walls:
+  - box: { species: glass }
+fill:
+  - lattice: { species: glass, spacing_m: 0.004, lo_m: [0.0, 0.0, 0.0], hi_m: [0.012, 0.012, 0.012], origin_m: [0.002, 0.002, 0.002] }
+time: { dt_s: 1.0e-5, end_time_s: 0.001 }
+gas: { density_kg_per_m3: 1.2, viscosity_pa_s: 1.8e-5, cells: [3, 3, 3], dem_steps_per_gas_step: 20 }
+heat:
+  initial_temperature_k: 300.0
+drying: { evaporation_coefficient: 1.0, inlet_relative_humidity: 0.5 }
+"#;
+
+const DRYING_CASES: &[(&str, &str, &str, &[&str])] = &[
+    (
+        "a negative evaporation coefficient",
+        "evaporation_coefficient: 1.0",
+        "evaporation_coefficient: -0.5",
+        &["drying.evaporation_coefficient", "expected 0 < α ≤ 1", "got -0.5"],
+    ),
+    (
+        "inlet humidity above saturation",
+        "inlet_relative_humidity: 0.5",
+        "inlet_relative_humidity: 1.2",
+        &["drying.inlet_relative_humidity", "above saturation", "from 0 to 1"],
+    ),
+    (
+        "a zero latent heat",
+        "inlet_relative_humidity: 0.5",
+        "inlet_relative_humidity: 0.5, latent_heat_j_per_kg: 0.0",
+        &["drying.latent_heat_j_per_kg", "expected a finite value > 0"],
+    ),
+    (
+        "drying without heat",
+        "heat:\n  initial_temperature_k: 300.0\ndrying:",
+        "drying:",
+        &["drying", "needs heat transfer", "`heat` section"],
+    ),
+];
+
 /// A fill temperature without a `heat` section.
 const NO_HEAT_CASES: &[(&str, &str, &str, &[&str])] = &[(
     "a fill temperature without heat",
@@ -415,6 +462,11 @@ fn bad_scenarios_fail_cleanly_before_writing_anything() {
 #[test]
 fn bad_heat_input_fails_cleanly_before_writing_anything() {
     check_cases(GOOD_HEAT, HEAT_CASES);
+}
+
+#[test]
+fn bad_drying_input_fails_cleanly_before_writing_anything() {
+    check_cases(GOOD_DRYING, DRYING_CASES);
 }
 
 /// Runs `good` (which must succeed) and each case's edit of it (which must fail at the edited line, exit 2, with

@@ -10,6 +10,7 @@
 //!   rule (seed 000 §4).
 //! - `escape_velocity`: the head-on escape velocity of a Hamaker pair and the Hamaker constant matching a square
 //!   well (seed 001 ch. 7).
+//! - `drying_curve`: the drying curve's times to 50 % and 90 % dried and its constant-rate period (seed 000 §7.3).
 //! - `wall_heat`: the wall-to-bed heat transfer coefficient h_w of a heated drum, its core temperature and contact
 //!   arc (seed 000 §5.2.4).
 //!
@@ -17,6 +18,7 @@
 //! state directly, and nothing here is called while a simulation steps.
 
 pub mod dimensionless;
+pub mod drying_curve;
 pub mod escape_velocity;
 pub mod fit;
 pub mod fluidization;

@@ -154,6 +154,30 @@ job_metrics! {
         "the angle of drum wall the bed touches, mean over the fit window";
     DrumWallContactTime => "drum_wall_contact_time_s", "s", [HeatedDrum],
         "t_c = arc/omega: how long a point of the wall stays under the bed (seed 000 eq. 5.18 read with the arc in rad and the speed in rev/s)";
+    ConstantRateDryingRate => "constant_rate_drying_rate_per_s", "1/s", [Drying],
+        "the drying rate -dX/dt of the constant-rate period (X the bed's moisture content, kg of liquid per kg of dry solid; seed 000 Figs. 91, 94): the fall of X over the longest stretch of series rows whose row-to-row rates stay positive and within 1.3x of each other, if it lasts at least a fifth of the drying time; NaN when there is none";
+    ConstantRatePeriod => "constant_rate_period_s", "s", [Drying],
+        "how long that constant-rate period lasts; 0 when the drying curve has none";
+    TimeTo50PctDried => "time_to_50pct_dried_s", "s", [Drying],
+        "when half of the start's liquid (on particles and in bridges) has gone, from the series; NaN if it has not by the end";
+    TimeTo90PctDried => "time_to_90pct_dried_s", "s", [Drying],
+        "when 90 % of the start's liquid has gone; NaN if it has not by the end";
+    FinalMoistureContent => "final_moisture_content", "1", [Drying],
+        "X at the end: the liquid on the particles and in bridges over the particles' dry mass, kg/kg";
+    MinMeanParticleTemperature => "min_mean_particle_temperature_k", "K", [Drying],
+        "the lowest mass-weighted mean particle temperature over the series rows (evaporative cooling, seed 000 Fig. 89c)";
+    TimeOfMinMeanParticleTemperature => "time_of_min_mean_particle_temperature_s", "s", [Drying],
+        "when that lowest mean temperature occurs";
+    LiquidFractionEvaporated => "liquid_fraction_evaporated", "1", [Drying],
+        "1 - X_end/X_0: the fraction of the start's liquid gone by the end (seed 000 Figs. 90, 93)";
+    MoistureLargestRise => "moisture_largest_rise", "1", [Drying],
+        "the largest rise of X from one series row to the next over X_0 (negative: the drying curve falls at every row; positive: vapour condensed back onto the bed somewhere in the run)";
+    EvaporativeCooling => "evaporative_cooling_k", "K", [Drying],
+        "the first row's mean particle temperature minus the lowest: how far evaporation cooled the bed before heat caught up (seed 000 Fig. 89c; 0 when it never fell)";
+    TemperatureRiseAfterMinimum => "temperature_rise_after_minimum_k", "K", [Drying],
+        "the last row's mean particle temperature minus the lowest: how far the bed warmed after its coldest moment";
+    DryingLedgerClosure => "drying_ledger_closure_max", "1", [Drying],
+        "the largest |(liquid + vapour in the gas + vapour gone out - vapour come in)/(start's liquid and vapour + sprayed) - 1| over the series rows: the mass balance of drying, a check (about 1e-13)";
 }
 
 impl JobMetric {
@@ -216,6 +240,8 @@ pub enum Need {
     Heat,
     /// A `heat` section and one drum wall held at a temperature (a kiln).
     HeatedDrum,
+    /// A `drying` section.
+    Drying,
 }
 
 impl Need {
@@ -233,6 +259,7 @@ impl Need {
             Need::ContactStatistics => "output.contact_statistics",
             Need::Heat => "heat transfer",
             Need::HeatedDrum => "a heated drum",
+            Need::Drying => "drying",
         }
     }
 
@@ -285,6 +312,10 @@ impl Need {
             Need::Heat => unless(
                 scenario.heat.is_some(),
                 format!("`{name}` needs heat transfer (a `heat:` section in the scenario)"),
+            ),
+            Need::Drying => unless(
+                scenario.drying.is_some(),
+                format!("`{name}` needs drying (a `drying:` section in the scenario)"),
             ),
             Need::HeatedDrum => {
                 let heated = scenario.heat.as_ref().map_or(0, |heat| {

@@ -23,8 +23,8 @@
 //! its evaporation draws on that pool in proportion: its film and its shares of its bridges lose the same
 //! fraction. A bridge thus evaporates through the surfaces of the particles it joins, never through a meniscus
 //! area of its own (the parabolic profile's free surface is not computed), and a bed whose liquid sits in bridges
-//! dries as fast per particle as one whose liquid is film, while a particle holds any. A bridge whose volume
-//! reaches zero is gone (its pair is dry).
+//! dries as fast per particle as one whose liquid is film, while a particle holds any. A bridge dried below
+//! [`SMALLEST_BRIDGE`] breaks, its remnant going back to its particles' films.
 //!
 //! **What is left out** (CHOICE, as the seed): the liquid's own heat capacity (the particle stays lumped with its
 //! solid's), the vapour's enthalpy carried into the gas (the gas's energy equation sees no evaporation), and the
@@ -52,6 +52,13 @@ pub const VAPOUR_FIELD: &str = "vapour_mass_fraction";
 
 /// Relative residual the vapour's linear solves reach: the ledger closes to about this (times the steps).
 pub const VAPOUR_SOLVE_TOLERANCE: f64 = 1e-14;
+
+/// A bridge that evaporation leaves below this volume over the smaller particle's R³ breaks, its remnant going back
+/// to its particles' films. CHOICE: the smallest volume the bridge tables hold (`models::bridge_conduction`), far
+/// below the smallest Mikami fitted; his fit extrapolated to vanishing volumes gives a force that grows without
+/// bound as ln V̂ → −∞ (eqs 2.16–2.17), so a bridge dried geometrically towards zero would hold its pair ever
+/// tighter (a drum's bed overlapped by a quarter radius within 0.6 s of heating before this floor).
+pub const SMALLEST_BRIDGE: f64 = 1e-6;
 
 /// Solves of one drying step before it gives up (the capped set grows by at least one particle per solve, and in
 /// practice settles within a few).
@@ -107,6 +114,8 @@ pub struct DryingStep {
     pub dried_out: usize,
     /// Linear iterations over the solves.
     pub linear_iterations: u64,
+    /// Bridges that dried below [`SMALLEST_BRIDGE`] and broke.
+    pub bridges_dried: usize,
 }
 
 /// One particle's rate, linear in its cell's vapour mass fraction: ṁ = e − f ρ w, kg/s (positive: evaporation).
@@ -298,20 +307,39 @@ pub fn dry(
             let j = list.partner[k] as usize;
             let (fi, fj) = (fraction[i], fraction[j]);
             if pairs[k] > 0.0 && (fi > 0.0 || fj > 0.0) {
-                pairs[k] = if fi >= 1.0 && fj >= 1.0 {
+                let left = if fi >= 1.0 && fj >= 1.0 {
                     0.0
                 } else {
                     pairs[k] * (1.0 - 0.5 * (fi + fj))
                 };
+                if left < SMALLEST_BRIDGE * p.radius_m[i].min(p.radius_m[j]).powi(3) {
+                    // Broken: its remnant goes back to the two films in halves.
+                    p.liquid_m3[i] += 0.5 * left;
+                    p.liquid_m3[j] += 0.5 * left;
+                    pairs[k] = 0.0;
+                    step.bridges_dried += 1;
+                } else {
+                    pairs[k] = left;
+                }
             }
         }
         if fraction[i] > 0.0 {
             for k in list.walls_of(i) {
-                walls[k] = if fraction[i] >= 1.0 {
+                if walls[k] == 0.0 {
+                    continue;
+                }
+                let left = if fraction[i] >= 1.0 {
                     0.0
                 } else {
                     walls[k] * (1.0 - fraction[i])
                 };
+                if left < SMALLEST_BRIDGE * p.radius_m[i].powi(3) {
+                    p.liquid_m3[i] += left;
+                    walls[k] = 0.0;
+                    step.bridges_dried += 1;
+                } else {
+                    walls[k] = left;
+                }
             }
         }
     }

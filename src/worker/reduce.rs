@@ -168,6 +168,16 @@ pub fn metrics(job: &JobSpec, built: &BuiltScenario, sim: &Simulation, series: &
     let cycle = || cycle_once.get_or_init(|| cycle(job, built, sim, series)).as_ref();
     let core_once = std::cell::OnceCell::new();
     let core = || *core_once.get_or_init(|| wall_heat(job, sim, series, "core_temperature_k"));
+    // The drying curve (t, X) and the coldest row of the mean particle temperature (t, T).
+    let drying_curve = || Some((series.column("time_s")?.to_vec(), series.column("moisture_content")?.to_vec()));
+    let mean_temperatures = || series.column("mean_temperature_k").filter(|t| !t.is_empty());
+    let coldest = || {
+        let (t, temperature) = (series.column("time_s")?, series.column("mean_temperature_k")?);
+        (0..t.len())
+            .filter(|&k| temperature[k].is_finite())
+            .min_by(|&a, &b| temperature[a].total_cmp(&temperature[b]))
+            .map(|k| (t[k], temperature[k]))
+    };
     let bed_once = std::cell::OnceCell::new();
     let bed = || *bed_once.get_or_init(|| wall_heat(job, sim, series, "mean_temperature_k"));
     job.metrics
@@ -265,6 +275,46 @@ pub fn metrics(job: &JobSpec, built: &BuiltScenario, sim: &Simulation, series: &
                 JobMetric::BedHeatingSlope => bed().map_or(f64::NAN, |(f, _)| f.slope_per_s),
                 JobMetric::DrumContactArc => core().map_or(f64::NAN, |(_, arc)| arc),
                 JobMetric::DrumWallContactTime => core().map_or(f64::NAN, |(f, _)| f.contact_time_s),
+                JobMetric::ConstantRateDryingRate => drying_curve()
+                    .and_then(|(t, x)| analysis::drying_curve::constant_rate_period(&t, &x))
+                    .map_or(f64::NAN, |p| p.rate_per_s),
+                JobMetric::ConstantRatePeriod => drying_curve().map_or(f64::NAN, |(t, x)| {
+                    analysis::drying_curve::constant_rate_period(&t, &x).map_or(0.0, |p| p.to_s - p.from_s)
+                }),
+                JobMetric::TimeTo50PctDried => drying_curve()
+                    .and_then(|(t, x)| analysis::drying_curve::time_to_fraction_removed(&t, &x, 0.5))
+                    .unwrap_or(f64::NAN),
+                JobMetric::TimeTo90PctDried => drying_curve()
+                    .and_then(|(t, x)| analysis::drying_curve::time_to_fraction_removed(&t, &x, 0.9))
+                    .unwrap_or(f64::NAN),
+                JobMetric::FinalMoistureContent => sim.gas.as_ref().and_then(|g| g.drying.as_ref()).map_or(
+                    f64::NAN,
+                    |d| {
+                        sim.total_liquid_m3() * d.config.liquid_density_kg_per_m3
+                            / sim.particles.mass_kg.iter().sum::<f64>()
+                    },
+                ),
+                JobMetric::MinMeanParticleTemperature => coldest().map_or(f64::NAN, |(_, t)| t),
+                JobMetric::TimeOfMinMeanParticleTemperature => coldest().map_or(f64::NAN, |(at, _)| at),
+                JobMetric::LiquidFractionEvaporated => drying_curve()
+                    .and_then(|(_, x)| Some(1.0 - x.last()? / x.first()?))
+                    .unwrap_or(f64::NAN),
+                JobMetric::MoistureLargestRise => drying_curve()
+                    .and_then(|(_, x)| {
+                        let x0 = *x.first()?;
+                        x.windows(2).map(|w| (w[1] - w[0]) / x0).reduce(f64::max)
+                    })
+                    .unwrap_or(f64::NAN),
+                JobMetric::EvaporativeCooling => {
+                    mean_temperatures().zip(coldest()).map_or(f64::NAN, |(t, (_, min))| t[0] - min)
+                }
+                JobMetric::TemperatureRiseAfterMinimum => mean_temperatures()
+                    .zip(coldest())
+                    .map_or(f64::NAN, |(t, (_, min))| t[t.len() - 1] - min),
+                JobMetric::DryingLedgerClosure => series
+                    .column("drying_closure")
+                    .and_then(|c| c.iter().map(|v| v.abs()).reduce(f64::max))
+                    .unwrap_or(f64::NAN),
             };
             Metric {
                 name: metric.name().to_string(),
