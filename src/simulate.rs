@@ -200,8 +200,7 @@ fn heat_columns(sim: &Simulation) -> String {
 /// moisture content X (that liquid over the particles' dry mass, kg/kg); the vapour in the gas, gone out through
 /// its boundary and evaporated since the start, kg; the gas's mean relative humidity; and the ledger's closure
 /// ([`Simulation::drying_closure`]).
-const DRYING_SERIES_COLUMNS: &str =
-    ",liquid_kg,bridge_liquid_kg,moisture_content,vapour_kg,vapour_out_kg,evaporated_kg,gas_relative_humidity,drying_closure";
+const DRYING_SERIES_COLUMNS: &str = ",liquid_kg,bridge_liquid_kg,moisture_content,vapour_kg,vapour_out_kg,evaporated_kg,gas_relative_humidity,drying_closure";
 
 /// The [`DRYING_SERIES_COLUMNS`], empty without drying.
 fn drying_columns(sim: &Simulation) -> String {

@@ -102,7 +102,17 @@ fn a_wet_particle_in_dry_gas_loses_liquid_at_the_hertz_knudsen_rate() {
 #[test]
 fn a_closed_box_saturates_at_the_saturation_pressure() {
     let fill = "  - lattice: { species: s, spacing_m: 0.004, lo_m: [0.0, 0.0, 0.0], hi_m: [0.012, 0.012, 0.012], origin_m: [0.002, 0.002, 0.002] }";
-    let b = built(&wet_box(0.012, 3, fill, 0.05, 1.0e9, 300.0, 1.0e9, "", "evaporation_coefficient: 1.0"));
+    let b = built(&wet_box(
+        0.012,
+        3,
+        fill,
+        0.05,
+        1.0e9,
+        300.0,
+        1.0e9,
+        "",
+        "evaporation_coefficient: 1.0",
+    ));
     let mut sim = with_gas(&b);
     let mut worst = 0.0f64;
     let mut lost_per_gas_step = Vec::new();
@@ -138,7 +148,17 @@ fn a_closed_box_saturates_at_the_saturation_pressure() {
 #[test]
 fn evaporation_cools_the_particles_and_the_energy_ledger_closes() {
     let fill = "  - lattice: { species: s, spacing_m: 0.004, lo_m: [0.0, 0.0, 0.0], hi_m: [0.012, 0.012, 0.012], origin_m: [0.002, 0.002, 0.002] }";
-    let b = built(&wet_box(0.012, 3, fill, 0.05, 800.0, 300.0, 1000.7, "", "evaporation_coefficient: 1.0"));
+    let b = built(&wet_box(
+        0.012,
+        3,
+        fill,
+        0.05,
+        800.0,
+        300.0,
+        1000.7,
+        "",
+        "evaporation_coefficient: 1.0",
+    ));
     let mut sim = with_gas(&b);
     let energy = |sim: &Simulation| {
         let p = &sim.particles;
@@ -153,7 +173,13 @@ fn evaporation_cools_the_particles_and_the_energy_ledger_closes() {
     for _ in 0..100 {
         sim.run_steps(20).expect("stable");
         worst = worst.max((energy(&sim) / e0 - 1.0).abs());
-        coldest = coldest.min(sim.particles.temperature_k.iter().copied().fold(f64::INFINITY, f64::min));
+        coldest = coldest.min(
+            sim.particles
+                .temperature_k
+                .iter()
+                .copied()
+                .fold(f64::INFINITY, f64::min),
+        );
     }
     let gas = sim.gas.as_ref().unwrap();
     println!(
@@ -174,9 +200,22 @@ fn evaporation_cools_the_particles_and_the_energy_ledger_closes() {
 fn a_drying_run_restarts_exactly() {
     let tmp = tempfile::tempdir().expect("temp dir");
     let fill = "  - lattice: { species: s, spacing_m: 0.004, lo_m: [0.0, 0.0, 0.0], hi_m: [0.012, 0.012, 0.012], origin_m: [0.002, 0.002, 0.002] }";
-    let yaml = wet_box(0.012, 3, fill, 0.05, 800.0, 300.0, 1000.7, "", "evaporation_coefficient: 0.5")
-        .replace("end_time_s: 0.2", "end_time_s: 0.05")
-        .replace("gravity: { vector_m_per_s2: [0.0, 0.0, 0.0] }", "gravity: { vector_m_per_s2: [0.0, -9.81, 0.0] }");
+    let yaml = wet_box(
+        0.012,
+        3,
+        fill,
+        0.05,
+        800.0,
+        300.0,
+        1000.7,
+        "",
+        "evaporation_coefficient: 0.5",
+    )
+    .replace("end_time_s: 0.2", "end_time_s: 0.05")
+    .replace(
+        "gravity: { vector_m_per_s2: [0.0, 0.0, 0.0] }",
+        "gravity: { vector_m_per_s2: [0.0, -9.81, 0.0] }",
+    );
     let (whole, split) = whole_and_resumed(tmp.path(), &yaml, 2510);
     let gas = whole.gas.as_ref().unwrap();
     assert_eq!(gas.scalars.len(), 2);
@@ -206,7 +245,10 @@ fn a_drying_bridge_breaks_and_the_pair_stays_at_rest() {
         "y_low: { inlet: { superficial_velocity_m_per_s: 1.0 } }, y_high: outlet",
         "evaporation_coefficient: 1.0",
     )
-    .replace("heat:\n  initial_temperature_k: 300.0", "heat:\n  initial_temperature_k: 360.0");
+    .replace(
+        "heat:\n  initial_temperature_k: 300.0",
+        "heat:\n  initial_temperature_k: 360.0",
+    );
     let b = built(&yaml);
     let mut sim = with_gas(&b);
     let bridge_m3 = |sim: &Simulation| sim.total_liquid_m3() - sim.particles.liquid_m3.iter().sum::<f64>();

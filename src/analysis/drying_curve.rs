@@ -36,7 +36,11 @@ pub fn time_to_fraction_removed(t_s: &[f64], moisture: &[f64], fraction: f64) ->
     for (&t, &x) in t_s.iter().zip(moisture) {
         if x <= level {
             let (tp, xp) = previous;
-            return Some(if xp > x { tp + (xp - level) / (xp - x) * (t - tp) } else { t });
+            return Some(if xp > x {
+                tp + (xp - level) / (xp - x) * (t - tp)
+            } else {
+                t
+            });
         }
         previous = (t, x);
     }
@@ -79,13 +83,13 @@ pub fn constant_rate_period(t_s: &[f64], moisture: &[f64]) -> Option<ConstantRat
     }
     let (start, end) = best?;
     let span = t_s[end] - t_s[start];
-    (end - start + 1 >= MIN_PERIOD_ROWS && drying_time_s > 0.0 && span >= MIN_PERIOD_FRACTION * drying_time_s).then(|| {
-        ConstantRatePeriod {
+    (end - start + 1 >= MIN_PERIOD_ROWS && drying_time_s > 0.0 && span >= MIN_PERIOD_FRACTION * drying_time_s).then(
+        || ConstantRatePeriod {
             from_s: t_s[start],
             to_s: t_s[end],
             rate_per_s: (moisture[start] - moisture[end]) / span,
-        }
-    })
+        },
+    )
 }
 
 #[cfg(test)]
@@ -98,7 +102,13 @@ mod tests {
         let t: Vec<f64> = (0..=200).map(|k| 0.1 * k as f64).collect();
         let x: Vec<f64> = t
             .iter()
-            .map(|&t| if t <= 5.0 { 1.0 - 0.1 * t } else { 0.5 * (-0.2 * (t - 5.0)).exp() })
+            .map(|&t| {
+                if t <= 5.0 {
+                    1.0 - 0.1 * t
+                } else {
+                    0.5 * (-0.2 * (t - 5.0)).exp()
+                }
+            })
             .collect();
         let period = constant_rate_period(&t, &x).expect("a constant-rate period");
         assert_eq!(period.from_s, 0.0);

@@ -763,12 +763,14 @@ impl Arrays {
                     },
                 })
                 .into_iter()
-                .chain((self.gas_vapour_mass_fraction.len() == cells && cells > 0).then(|| GasScalarSnapshot {
-                    name: GAS_VAPOUR.into(),
-                    unit: "kg/kg".into(),
-                    value: self.gas_vapour_mass_fraction,
-                    exchange: ExchangeAccumulator::new(cells),
-                }))
+                .chain(
+                    (self.gas_vapour_mass_fraction.len() == cells && cells > 0).then(|| GasScalarSnapshot {
+                        name: GAS_VAPOUR.into(),
+                        unit: "kg/kg".into(),
+                        value: self.gas_vapour_mass_fraction,
+                        exchange: ExchangeAccumulator::new(cells),
+                    }),
+                )
                 .collect(),
             drying: (self.drying_evaporated_kg.len() == 1).then(|| crate::engine::drying::DryingLedger {
                 initial_liquid_kg: self.drying_initial_liquid_kg[0],

@@ -184,7 +184,10 @@ pub fn dry(
         .step_flows
         .take()
         .ok_or("the drying step needs the gas step's flows")?;
-    let temperature = gas.temperature_k().ok_or("drying needs the gas's temperature")?.to_vec();
+    let temperature = gas
+        .temperature_k()
+        .ok_or("drying needs the gas's temperature")?
+        .to_vec();
     let grid = gas.solver.config.grid.clone();
     let volume = grid.cell_volume_m3();
     let rho = gas.solver.config.density_kg_per_m3;
@@ -205,12 +208,8 @@ pub fn dry(
             continue;
         }
         let t = p.temperature_k[i];
-        let a = hertz_knudsen_conductance_kg_per_s_pa(
-            config.evaporation_coefficient,
-            2.0 * p.radius_m[i],
-            t,
-            molar_mass,
-        );
+        let a =
+            hertz_knudsen_conductance_kg_per_s_pa(config.evaporation_coefficient, 2.0 * p.radius_m[i], t, molar_mass);
         let thermal_mass = p.mass_kg[i] * heat_capacity_j_per_kg_k[p.species[i].index()];
         let d = 1.0 + a * saturation_pressure_slope_pa_per_k(t) * latent * dt_s / thermal_mass;
         let pressure_per_density = GAS_CONSTANT_J_PER_MOL_K * temperature[c] / molar_mass;
@@ -361,7 +360,9 @@ impl GasCoupling {
             return Err("drying needs the gas's temperature".into());
         }
         if spec.exchange != ScalarExchange::Evaporation || spec.name != VAPOUR_FIELD {
-            return Err(format!("the vapour field must be {VAPOUR_FIELD} with the evaporation exchange"));
+            return Err(format!(
+                "the vapour field must be {VAPOUR_FIELD} with the evaporation exchange"
+            ));
         }
         let vapour = self.declare_scalar(spec)?;
         self.drying = Some(GasDrying {
@@ -395,8 +396,8 @@ impl GasCoupling {
         let porosity = &self.solver.state.porosity;
         let (mut sum, mut weight) = (0.0, 0.0);
         for c in (0..w.len()).filter(|&c| !config.blocked.get(c).copied().unwrap_or(false)) {
-            let p_v = config.density_kg_per_m3 * w[c] * GAS_CONSTANT_J_PER_MOL_K * t[c]
-                / drying.config.molar_mass_kg_per_mol;
+            let p_v =
+                config.density_kg_per_m3 * w[c] * GAS_CONSTANT_J_PER_MOL_K * t[c] / drying.config.molar_mass_kg_per_mol;
             sum += porosity[c] * p_v / saturation_pressure_pa(t[c]);
             weight += porosity[c];
         }

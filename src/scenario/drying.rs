@@ -11,8 +11,7 @@ use super::spec::ScenarioSpec;
 use crate::engine::drying::DryingConfig;
 use crate::engine::gas::{GasScalarSpec, ScalarExchange, ScalarWall};
 use crate::engine::models::evaporation::{
-    NORMAL_ATMOSPHERE_PA, WATER_MOLAR_MASS_KG_PER_MOL, saturated_vapour_density_kg_per_m3,
-    vapour_diffusivity_m2_per_s,
+    NORMAL_ATMOSPHERE_PA, WATER_MOLAR_MASS_KG_PER_MOL, saturated_vapour_density_kg_per_m3, vapour_diffusivity_m2_per_s,
 };
 
 /// Evaporation of the particles' liquid (water: its saturation pressure is seed 000's eq. 7.4) into the gas.
@@ -77,7 +76,10 @@ pub(super) fn build_drying(path: &Path, spec: &ScenarioSpec, gas: Option<&mut Ga
         ("liquid_density_kg_per_m3", drying.liquid_density_kg_per_m3, "kg/m3"),
     ] {
         if !(value.is_finite() && value > 0.0) {
-            return Err(fail(&format!("drying.{key}"), format!("expected a finite value > 0 {unit}, got {value}")));
+            return Err(fail(
+                &format!("drying.{key}"),
+                format!("expected a finite value > 0 {unit}, got {value}"),
+            ));
         }
     }
     for (key, value) in [
@@ -85,7 +87,10 @@ pub(super) fn build_drying(path: &Path, spec: &ScenarioSpec, gas: Option<&mut Ga
         ("inlet_relative_humidity", drying.inlet_relative_humidity),
     ] {
         if !(value.is_finite() && value >= 0.0) {
-            return Err(fail(&format!("drying.{key}"), format!("expected a relative humidity from 0 to 1, got {value}")));
+            return Err(fail(
+                &format!("drying.{key}"),
+                format!("expected a relative humidity from 0 to 1, got {value}"),
+            ));
         }
         if value > 1.0 {
             return Err(fail(

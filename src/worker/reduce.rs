@@ -169,7 +169,12 @@ pub fn metrics(job: &JobSpec, built: &BuiltScenario, sim: &Simulation, series: &
     let core_once = std::cell::OnceCell::new();
     let core = || *core_once.get_or_init(|| wall_heat(job, sim, series, "core_temperature_k"));
     // The drying curve (t, X) and the coldest row of the mean particle temperature (t, T).
-    let drying_curve = || Some((series.column("time_s")?.to_vec(), series.column("moisture_content")?.to_vec()));
+    let drying_curve = || {
+        Some((
+            series.column("time_s")?.to_vec(),
+            series.column("moisture_content")?.to_vec(),
+        ))
+    };
     let mean_temperatures = || series.column("mean_temperature_k").filter(|t| !t.is_empty());
     let coldest = || {
         let (t, temperature) = (series.column("time_s")?, series.column("mean_temperature_k")?);
@@ -287,13 +292,12 @@ pub fn metrics(job: &JobSpec, built: &BuiltScenario, sim: &Simulation, series: &
                 JobMetric::TimeTo90PctDried => drying_curve()
                     .and_then(|(t, x)| analysis::drying_curve::time_to_fraction_removed(&t, &x, 0.9))
                     .unwrap_or(f64::NAN),
-                JobMetric::FinalMoistureContent => sim.gas.as_ref().and_then(|g| g.drying.as_ref()).map_or(
-                    f64::NAN,
-                    |d| {
+                JobMetric::FinalMoistureContent => {
+                    sim.gas.as_ref().and_then(|g| g.drying.as_ref()).map_or(f64::NAN, |d| {
                         sim.total_liquid_m3() * d.config.liquid_density_kg_per_m3
                             / sim.particles.mass_kg.iter().sum::<f64>()
-                    },
-                ),
+                    })
+                }
                 JobMetric::MinMeanParticleTemperature => coldest().map_or(f64::NAN, |(_, t)| t),
                 JobMetric::TimeOfMinMeanParticleTemperature => coldest().map_or(f64::NAN, |(at, _)| at),
                 JobMetric::LiquidFractionEvaporated => drying_curve()
@@ -305,9 +309,9 @@ pub fn metrics(job: &JobSpec, built: &BuiltScenario, sim: &Simulation, series: &
                         x.windows(2).map(|w| (w[1] - w[0]) / x0).reduce(f64::max)
                     })
                     .unwrap_or(f64::NAN),
-                JobMetric::EvaporativeCooling => {
-                    mean_temperatures().zip(coldest()).map_or(f64::NAN, |(t, (_, min))| t[0] - min)
-                }
+                JobMetric::EvaporativeCooling => mean_temperatures()
+                    .zip(coldest())
+                    .map_or(f64::NAN, |(t, (_, min))| t[0] - min),
                 JobMetric::TemperatureRiseAfterMinimum => mean_temperatures()
                     .zip(coldest())
                     .map_or(f64::NAN, |(t, (_, min))| t[t.len() - 1] - min),

@@ -418,7 +418,9 @@ impl GasCoupling {
             (Some(drying), Some(ledger)) => drying.ledger = *ledger,
             (None, None) => {}
             (Some(_), None) => return Err("the scenario dries but the checkpoint's gas holds no drying ledger".into()),
-            (None, Some(_)) => return Err("the checkpoint's gas holds a drying ledger but the scenario does not dry".into()),
+            (None, Some(_)) => {
+                return Err("the checkpoint's gas holds a drying ledger but the scenario does not dry".into());
+            }
         }
         self.last = snap.last;
         Ok(())
