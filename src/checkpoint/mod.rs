@@ -572,17 +572,34 @@ mod tests {
                     velocity_m_per_s: (0..5).map(|k| v(-0.5, 0.25 * k as f64, SUBNORMAL)).collect(),
                     velocity_sum_m_per_s: (0..5).map(|k| v(3.0 * k as f64, -7.5, 1e-9)).collect(),
                 }),
-                scalars: vec![crate::engine::gas::coupled::GasScalarSnapshot {
-                    name: "temperature_k".into(),
-                    unit: "K".into(),
-                    value: vec![300.0, 301.5, 1e-300, 400.0, 299.25, 350.125],
-                    exchange: crate::engine::gas::ExchangeAccumulator {
-                        coefficient_sum: vec![0.0; 6],
-                        coefficient_value_sum: vec![0.0; 6],
-                        transfer_sum: vec![-0.5, 2.0e-9, 0.0, 3.25, -7.0, 1.0],
-                        steps: 3,
+                scalars: vec![
+                    crate::engine::gas::coupled::GasScalarSnapshot {
+                        name: "temperature_k".into(),
+                        unit: "K".into(),
+                        value: vec![300.0, 301.5, 1e-300, 400.0, 299.25, 350.125],
+                        exchange: crate::engine::gas::ExchangeAccumulator {
+                            coefficient_sum: vec![0.0; 6],
+                            coefficient_value_sum: vec![0.0; 6],
+                            transfer_sum: vec![-0.5, 2.0e-9, 0.0, 3.25, -7.0, 1.0],
+                            steps: 3,
+                        },
                     },
-                }],
+                    crate::engine::gas::coupled::GasScalarSnapshot {
+                        // A drying run's vapour (its accumulator is never filled between gas steps).
+                        name: "vapour_mass_fraction".into(),
+                        unit: "kg/kg".into(),
+                        value: vec![0.0, 1e-3, SUBNORMAL, 0.02, 5e-300, 0.0125],
+                        exchange: crate::engine::gas::ExchangeAccumulator::new(6),
+                    },
+                ],
+                drying: Some(crate::engine::drying::DryingLedger {
+                    initial_liquid_kg: 1.25e-4,
+                    initial_vapour_kg: 0.0,
+                    sprayed_kg: SUBNORMAL,
+                    evaporated_kg: -3.5e-9,
+                    vapour_in_kg: 1e-300,
+                    vapour_out_kg: 7.0e-7,
+                }),
             }),
         }
     }
