@@ -1157,6 +1157,24 @@ mod tests {
             &[1],
             &heat.exchange.steps.to_le_bytes(),
         );
+        let vapour = &gas.scalars[1];
+        ds(
+            &mut b,
+            "gas/vapour_mass_fraction",
+            &[6],
+            &f(vapour.value.iter().copied()),
+        );
+        let ledger = gas.drying.expect("the sample dries");
+        for (name, value) in [
+            ("gas/drying/initial_liquid_kg", ledger.initial_liquid_kg),
+            ("gas/drying/initial_vapour_kg", ledger.initial_vapour_kg),
+            ("gas/drying/sprayed_kg", ledger.sprayed_kg),
+            ("gas/drying/evaporated_kg", ledger.evaporated_kg),
+            ("gas/drying/vapour_in_kg", ledger.vapour_in_kg),
+            ("gas/drying/vapour_out_kg", ledger.vapour_out_kg),
+        ] {
+            ds(&mut b, name, &[1], &value.to_bits().to_le_bytes());
+        }
         let held = gas.held_drag.as_ref().expect("the sample holds held drag");
         ds(&mut b, "gas/held_drag/position_m", &[n, 3], &v3(&held.position_m));
         ds(

@@ -13,8 +13,8 @@
 //! w_c: ṁ_i = e_i − f_i ρ_g w_c, e_i = a_i p_sat/D_i, f_i = a_i R T_g,c/(M D_i), D_i = 1 + a_i p′ H Δt/(m_i c_p,i).
 //! The vapour's step takes Σ_i (e_i − f_i ρ_g w_c)/V_c as its exchange with the particles (implicit in w), in the
 //! conservative form; each particle then evaporates exactly ṁ_i Δt at the new w and cools by ṁ_i H Δt/(m c_p).
-//! A particle cannot give more than it holds: one whose ṁ_i Δt exceeds its liquid gives all of it (a dry one
-//! gives nothing) as a fixed source, and the vapour's step is solved again; the set of such particles only grows,
+//! A particle cannot give more than it holds: one whose ṁ_i Δt exceeds its liquid, or would leave less than
+//! [`SMALLEST_BRIDGE`] R³ of it, gives all of it (a dry one gives nothing) as a fixed source, and the vapour's step is solved again; the set of such particles only grows,
 //! so this ends (in practice after a few solves). A particle colder than the vapour's dew point condenses
 //! (ṁ < 0) onto its film, as eq. 7.1 allows.
 //!
@@ -54,7 +54,9 @@ pub const VAPOUR_FIELD: &str = "vapour_mass_fraction";
 pub const VAPOUR_SOLVE_TOLERANCE: f64 = 1e-14;
 
 /// A bridge that evaporation leaves below this volume over the smaller particle's R³ breaks, its remnant going back
-/// to its particles' films. CHOICE: the smallest volume the bridge tables hold (`models::bridge_conduction`), far
+/// to its particles' films; a particle that would keep less than this over its R³ evaporates all it holds, and a
+/// film left below it evaporates at the end of the step into the particle's cell (bridges of 1e-120 m³, formed
+/// from films that had shrunk step after step, pulled E6's beads into quarter-radius overlaps). CHOICE: the smallest volume the bridge tables hold (`models::bridge_conduction`), far
 /// below the smallest Mikami fitted; his fit extrapolated to vanishing volumes gives a force that grows without
 /// bound as ln V̂ → −∞ (eqs 2.16–2.17), so a bridge dried geometrically towards zero would hold its pair ever
 /// tighter (a drum's bed overlapped by a quarter radius within 0.6 s of heating before this floor).
@@ -127,6 +129,8 @@ struct Rate {
     f_rho_kg_per_s: f64,
     /// The most it can evaporate over the step, kg/s (its liquid over Δt).
     available_kg_per_s: f64,
+    /// [`SMALLEST_BRIDGE`] R³ of liquid over Δt, kg/s: evaporating to less than that left dries it out.
+    floor_kg_per_s: f64,
     /// Set once it evaporates `available_kg_per_s` whatever w is.
     fixed: Option<f64>,
 }
@@ -218,6 +222,7 @@ pub fn dry(
             e_kg_per_s: a * saturation_pressure_pa(t) / d,
             f_rho_kg_per_s: a * pressure_per_density * rho / d,
             available_kg_per_s: pool_m3[i] * config.liquid_density_kg_per_m3 / dt_s,
+            floor_kg_per_s: SMALLEST_BRIDGE * p.radius_m[i].powi(3) * config.liquid_density_kg_per_m3 / dt_s,
             fixed: None,
         }));
     }
@@ -257,7 +262,9 @@ pub fn dry(
         step.linear_iterations += report.iterations as u64;
         let mut changed = false;
         for r in rates.iter_mut().flatten() {
-            if r.fixed.is_none() && r.at(w[r.cell]) > r.available_kg_per_s {
+            let rate = r.at(w[r.cell]);
+            // More than it holds, or so much that less than the floor would be left: it dries out.
+            if r.fixed.is_none() && rate > 0.0 && rate > r.available_kg_per_s - r.floor_kg_per_s {
                 r.fixed = Some(r.available_kg_per_s);
                 changed = true;
             }
@@ -340,6 +347,22 @@ pub fn dry(
                     walls[k] = left;
                 }
             }
+        }
+    }
+    // Films left below the floor (a bridge's remnant, or a film shrunk with its pool) evaporate now, into the
+    // particle's cell, with their latent heat: a film must not decay towards zero and form a vanishing bridge.
+    let mut w = w;
+    let porosity = &gas.solver.state.porosity;
+    for (i, rate) in rates.iter().enumerate() {
+        let Some(r) = rate else { continue };
+        let film = p.liquid_m3[i];
+        if film > 0.0 && film < SMALLEST_BRIDGE * p.radius_m[i].powi(3) {
+            let m_kg = film * config.liquid_density_kg_per_m3;
+            p.liquid_m3[i] = 0.0;
+            w[r.cell] += m_kg / (porosity[r.cell] * rho * volume);
+            let thermal_mass = p.mass_kg[i] * heat_capacity_j_per_kg_k[p.species[i].index()];
+            p.temperature_k[i] -= m_kg * latent / thermal_mass;
+            step.evaporated_kg += m_kg;
         }
     }
     let vapour = gas.scalar_mut(drying.vapour);
