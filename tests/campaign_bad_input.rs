@@ -356,7 +356,7 @@ const CASES: &[(&str, &str, &str, &[&str])] = &[
         "rotation_rpm",
         &[
             "key `sweep.grid[0].param`",
-            "no `rotation_rpm` at the top level (there: cohesion, cohesion_off, contact, domain, fill, gas,",
+            "no `rotation_rpm` at the top level (there: cohesion, cohesion_off, contact, domain, drying, fill, gas,",
         ],
     ),
     (
