@@ -176,8 +176,11 @@ pub const GAS_SERIES_COLUMNS: &str = ",column_pressure_drop_pa,probe_pressure_dr
 node_weight_per_area_pa,gas_outer_iterations,gas_linear_iterations,gas_mass_imbalance";
 
 /// The series columns of a run with heat transfer: the particles' mass-weighted mean temperature and the coldest and
-/// hottest particle's, K.
-const HEAT_SERIES_COLUMNS: &str = ",mean_temperature_k,min_temperature_k,max_temperature_k";
+/// hottest particle's, K; the energy ledger's heat from the walls into the particles and into the gas across its
+/// boundary (net) since the start, and the gas temperature equation's continuity term, J; and the ledger's closure
+/// ([`Simulation::energy_closure`], `engine::heat_ledger`).
+const HEAT_SERIES_COLUMNS: &str = ",mean_temperature_k,min_temperature_k,max_temperature_k,wall_heat_to_particles_j,\
+gas_boundary_heat_j,gas_continuity_heat_j,energy_closure";
 
 /// The heat columns ([`HEAT_SERIES_COLUMNS`]), empty without heat transfer.
 fn heat_columns(sim: &Simulation) -> String {
@@ -193,7 +196,15 @@ fn heat_columns(sim: &Simulation) -> String {
         .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), &t| {
             (lo.min(t), hi.max(t))
         });
-    format!(",{mean:e},{lo:e},{hi:e}")
+    let (to_particles, to_gas, continuity) = sim.heat_ledger.as_ref().map_or((f64::NAN, f64::NAN, f64::NAN), |l| {
+        (
+            l.wall_to_particles_j,
+            l.gas_boundary_in_j - l.gas_boundary_out_j,
+            l.gas_continuity_j,
+        )
+    });
+    let closure = sim.energy_closure().unwrap_or(f64::NAN);
+    format!(",{mean:e},{lo:e},{hi:e},{to_particles:e},{to_gas:e},{continuity:e},{closure:e}")
 }
 
 /// The drying columns of a run with `drying`: the liquid on particles and in bridges (and in bridges alone), kg; the
@@ -552,6 +563,7 @@ pub fn run_in_dir(built: &BuiltScenario, out: &Path, ctl: RunControl) -> Result<
                 threads,
             )?;
             attach_gas(built, &mut sim, None)?;
+            sim.start_heat_ledger();
             if built.spec.output.net_forces {
                 sim.record_net_forces();
             }

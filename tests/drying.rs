@@ -6,7 +6,7 @@ mod common;
 
 use std::f64::consts::PI;
 
-use common::{built, whole_and_resumed, with_gas};
+use common::{KILN, built, whole_and_resumed, with_gas, with_gas_on};
 use granflow::engine::Simulation;
 use granflow::engine::models::evaporation::{
     WATER_MOLAR_MASS_KG_PER_MOL, hertz_knudsen_conductance_kg_per_s_pa, saturation_pressure_pa, vapour_pressure_pa,
@@ -192,6 +192,9 @@ fn evaporation_cools_the_particles_and_the_energy_ledger_closes() {
     assert!(coldest < 299.9, "evaporative cooling");
     assert!(gas.mean_temperature_k().unwrap() < 300.0);
     assert!(worst < 1e-10);
+    // The product's own ledger agrees (nothing crosses an adiabatic box's boundary).
+    let closure = sim.energy_closure().expect("a heat run has an energy ledger");
+    assert!(closure.abs() < 1e-10, "{closure:e}");
 }
 
 /// The vapour, the ledger, the liquid and the temperatures are in the checkpoint: a drying run stopped between gas
@@ -271,4 +274,52 @@ fn a_drying_bridge_breaks_and_the_pair_stays_at_rest() {
     assert!(sim.total_liquid_m3() == 0.0, "dry");
     assert!(largest_overlap < 0.01 * 1e-3, "{largest_overlap}");
     assert!(worst < 1e-10);
+}
+
+/// The energy ledger of a heated drying drum (`engine::heat_ledger`): the wall at 400 K heats the wet beads through
+/// contacts, gas lenses and wall bridges, and the gas through the drum's wall; evaporation takes latent heat. The
+/// held energy (particles, gas, latent heat of the liquid evaporated) equals the start plus the heat from the walls
+/// and across the gas's boundary (with the gas temperature's continuity term) at every gas step, to 1e-10, while
+/// that heat is percent of the start's; and the ledger is the same bits on one thread and on two.
+#[test]
+fn a_heated_drying_drum_closes_its_energy_ledger_on_any_thread_count() {
+    let yaml = KILN
+        .replace(
+            "youngs_modulus_pa: 1.0e7 }",
+            "youngs_modulus_pa: 1.0e7, contact_angle_deg: 0.0, liquid_content: 0.02 }",
+        )
+        .replace(
+            "walls:\n  - drum",
+            "cohesion: { liquid_bridge: { surface_tension_n_per_m: 0.072, viscosity_pa_s: 0.001, walls: true } }\nwalls:\n  - drum",
+        )
+        .replace("from_s: 0.02 } }", "from_s: 0.0 } }\n  gas: { lens_conduction: {} }")
+        + "drying: { evaporation_coefficient: 1.0 }\n";
+    let b = built(&yaml);
+    let mut one = with_gas_on(&b, 1);
+    let mut two = with_gas_on(&b, 2);
+    let e0 = one.heat_ledger.expect("started").initial_energy_j;
+    let mut worst = 0.0f64;
+    for _ in 0..150 {
+        one.run_steps(20).expect("stable");
+        two.run_steps(20).expect("stable");
+        worst = worst.max(one.energy_closure().unwrap().abs());
+    }
+    let ledger = one.heat_ledger.unwrap();
+    let evaporated = one.gas.as_ref().unwrap().drying.as_ref().unwrap().ledger.evaporated_kg;
+    println!(
+        "heated drying drum, 0.06 s: E0 {e0:.4} J, walls into particles {:.4e} J, into the gas {:.4e} J (out {:.3e}), \
+         continuity term {:.3e} J, latent {:.3e} J, worst closure {worst:.2e}",
+        ledger.wall_to_particles_j,
+        ledger.gas_boundary_in_j,
+        ledger.gas_boundary_out_j,
+        ledger.gas_continuity_j,
+        2.26e6 * evaporated
+    );
+    assert!(ledger.wall_to_particles_j > 1e-3 * e0, "the wall heated the beads");
+    assert!(ledger.gas_boundary_in_j > 0.0, "the wall heated the gas");
+    assert!(evaporated > 0.0);
+    assert!(worst < 1e-10, "{worst:e}");
+    if let Some(diff) = first_difference(&one.snapshot(), &two.snapshot()) {
+        panic!("one thread and two differ: {diff}");
+    }
 }

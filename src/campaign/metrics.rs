@@ -178,6 +178,8 @@ job_metrics! {
         "the last row's mean particle temperature minus the lowest: how far the bed warmed after its coldest moment";
     DryingLedgerClosure => "drying_ledger_closure_max", "1", [Drying],
         "the largest |(liquid + vapour in the gas + vapour gone out - vapour come in)/(start's liquid and vapour + sprayed) - 1| over the series rows: the mass balance of drying, a check (about 1e-13)";
+    EnergyLedgerClosure => "energy_ledger_closure_max", "1", [Heat],
+        "the largest |E_held/(E_start + heat in from walls and across the gas's boundary) - 1| over the series rows, E_held the particles' and gas's thermal energy plus the latent heat of the liquid evaporated (engine/heat_ledger.rs): the energy balance, a check";
 }
 
 impl JobMetric {

@@ -26,6 +26,7 @@ use crate::engine::contacts::{ContactStore, WallId};
 use crate::engine::gas::ExchangeAccumulator;
 use crate::engine::gas::coupled::{GasScalarSnapshot, GasSnapshot, GasStepStats};
 use crate::engine::gas::held_drag::HeldDragSnapshot;
+use crate::engine::heat_ledger::HeatLedger;
 use crate::engine::models::ContactHistory;
 use crate::engine::models::history::{FieldKind, FieldValue, HISTORY_FIELDS, HistoryField};
 use crate::engine::net_force::NetForceTally;
@@ -76,6 +77,8 @@ pub(crate) enum Rows {
     GasCellsIfDrying,
     /// One value when the gas carries vapour, none otherwise.
     GasScalarIfDrying,
+    /// One value when the run has heat transfer (an energy ledger), none otherwise.
+    ScalarIfHeat,
 }
 
 /// One dataset of the layout.
@@ -408,6 +411,12 @@ datasets! {
     sprayed_m3: f64 => "particles/sprayed_m3", Rows::Particles, 1, "m3";
     temperature_k: f64 => "particles/temperature_k", Rows::ParticlesIfRecorded, 1, "K";
 
+    heat_initial_energy_j: f64 => "heat_ledger/initial_energy_j", Rows::ScalarIfHeat, 1, "J";
+    heat_wall_to_particles_j: f64 => "heat_ledger/wall_to_particles_j", Rows::ScalarIfHeat, 1, "J";
+    heat_gas_boundary_in_j: f64 => "heat_ledger/gas_boundary_in_j", Rows::ScalarIfHeat, 1, "J";
+    heat_gas_boundary_out_j: f64 => "heat_ledger/gas_boundary_out_j", Rows::ScalarIfHeat, 1, "J";
+    heat_gas_continuity_j: f64 => "heat_ledger/gas_continuity_j", Rows::ScalarIfHeat, 1, "J";
+
     net_force_steps: u64 => "net_force/steps", Rows::NetForce, 1, "1";
     net_force_fluid_n: f64 => "net_force/fluid_sum_n", Rows::NetForce, 3, "N";
     net_force_wall_contact_n: f64 => "net_force/wall_contact_sum_n", Rows::NetForceWalls, 3, "N";
@@ -428,6 +437,7 @@ pub(crate) const GROUPS: &[&str] = &[
     "gas/drying",
     "net_force",
     "particles/channels",
+    "heat_ledger",
 ];
 
 /// The scalar part of a checkpoint: the root attributes other than `format` and the checksum.
@@ -459,6 +469,7 @@ impl Arrays {
         let vapour = gas.and_then(|g| g.scalars.iter().find(|s| s.name == GAS_VAPOUR));
         let ledger = gas.and_then(|g| g.drying.as_ref());
         let ledger_value = |f: fn(&crate::engine::drying::DryingLedger) -> f64| ledger.map(f).into_iter().collect();
+        let heat_value = |f: fn(&HeatLedger) -> f64| state.heat_ledger.as_ref().map(f).into_iter().collect();
         Arrays {
             particle_id: p.id.iter().map(|id| id.0).collect(),
             particle_species: p.species.iter().map(|s| s.0).collect(),
@@ -536,6 +547,11 @@ impl Arrays {
             sprayed_m3: p.sprayed_m3.clone(),
             temperature_k: p.temperature_k.clone(),
 
+            heat_initial_energy_j: heat_value(|l| l.initial_energy_j),
+            heat_wall_to_particles_j: heat_value(|l| l.wall_to_particles_j),
+            heat_gas_boundary_in_j: heat_value(|l| l.gas_boundary_in_j),
+            heat_gas_boundary_out_j: heat_value(|l| l.gas_boundary_out_j),
+            heat_gas_continuity_j: heat_value(|l| l.gas_continuity_j),
             net_force_steps: state.net_force.as_ref().map(|t| t.steps).into_iter().collect(),
             net_force_fluid_n: state
                 .net_force
@@ -641,6 +657,19 @@ impl Arrays {
             return Err(format!(
                 "/gas/vapour_mass_fraction has {vapour_cells} values and the /gas/drying datasets {ledger:?}, \
                  expected none, or one per gas cell ({gas_cells}, with a gas temperature) and one each"
+            ));
+        }
+        let heat_ledger = [
+            self.heat_initial_energy_j.len(),
+            self.heat_wall_to_particles_j.len(),
+            self.heat_gas_boundary_in_j.len(),
+            self.heat_gas_boundary_out_j.len(),
+            self.heat_gas_continuity_j.len(),
+        ];
+        if heat_ledger.iter().any(|&len| len > 1 || len != heat_ledger[0]) {
+            return Err(format!(
+                "the /heat_ledger datasets have {heat_ledger:?} elements, expected one each (a run with heat \
+                 transfer) or none"
             ));
         }
         let optional = CHANNELS
@@ -787,9 +816,17 @@ impl Arrays {
             wall_contact_n: unflatten(&self.net_force_wall_contact_n),
             wall_cohesion_n: unflatten(&self.net_force_wall_cohesion_n),
         });
+        let heat_ledger = (self.heat_initial_energy_j.len() == 1).then(|| HeatLedger {
+            initial_energy_j: self.heat_initial_energy_j[0],
+            wall_to_particles_j: self.heat_wall_to_particles_j[0],
+            gas_boundary_in_j: self.heat_gas_boundary_in_j[0],
+            gas_boundary_out_j: self.heat_gas_boundary_out_j[0],
+            gas_continuity_j: self.heat_gas_continuity_j[0],
+        });
         SimState {
             gas,
             net_force,
+            heat_ledger,
             step: header.step,
             time_s: header.time_s,
             dt_s: header.dt_s,
@@ -829,7 +866,8 @@ impl Visitor for ShapeCheck {
             | Rows::GasCellsIfHeat
             | Rows::GasScalarIfHeat
             | Rows::GasCellsIfDrying
-            | Rows::GasScalarIfDrying => Ok(()),
+            | Rows::GasScalarIfDrying
+            | Rows::ScalarIfHeat => Ok(()),
             _ if !len.is_multiple_of(spec.width) => Err(format!(
                 "/{} has {len} elements, not a multiple of {}",
                 spec.path, spec.width

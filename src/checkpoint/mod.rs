@@ -31,7 +31,7 @@ use crate::engine::SimState;
 
 /// Version of the file layout. Bump it whenever a name, type, shape or the checksum definition changes; readers
 /// reject any other version with [`CheckpointError::Version`].
-pub const CHECKPOINT_FORMAT_VERSION: u32 = 9;
+pub const CHECKPOINT_FORMAT_VERSION: u32 = 10;
 
 /// Metadata stored beside the state.
 #[derive(Debug, Clone, PartialEq)]
@@ -417,6 +417,7 @@ fn expected_shape(spec: &DatasetSpec) -> String {
         Rows::GasScalarIfHeat => "0 or 1".to_string(),
         Rows::GasCellsIfDrying => "0 or gas cells".to_string(),
         Rows::GasScalarIfDrying => "0 or 1".to_string(),
+        Rows::ScalarIfHeat => "0 or 1".to_string(),
     };
     if spec.width == 1 {
         format!("[{rows}]")
@@ -540,6 +541,13 @@ mod tests {
                 stream: 0xdead_beef_1234_5678,
                 word_pos: (1u128 << 70) + 12_345,
             },
+            heat_ledger: Some(crate::engine::heat_ledger::HeatLedger {
+                initial_energy_j: 12.5,
+                wall_to_particles_j: SUBNORMAL,
+                gas_boundary_in_j: 3.0e-4,
+                gas_boundary_out_j: -0.0,
+                gas_continuity_j: -1.25e-9,
+            }),
             // Net-force sums for the two walls.
             net_force: Some(crate::engine::net_force::NetForceTally {
                 steps: 37,
@@ -694,6 +702,7 @@ mod tests {
         let mut state = sample_state();
         state.gas = None;
         state.net_force = None;
+        state.heat_ledger = None;
         round_trip(&state, &sample_meta());
     }
 
@@ -1193,6 +1202,16 @@ mod tests {
             &[n],
             &f(p.temperature_k.iter().copied()),
         );
+        let heat = state.heat_ledger.expect("the sample has an energy ledger");
+        for (name, value) in [
+            ("heat_ledger/initial_energy_j", heat.initial_energy_j),
+            ("heat_ledger/wall_to_particles_j", heat.wall_to_particles_j),
+            ("heat_ledger/gas_boundary_in_j", heat.gas_boundary_in_j),
+            ("heat_ledger/gas_boundary_out_j", heat.gas_boundary_out_j),
+            ("heat_ledger/gas_continuity_j", heat.gas_continuity_j),
+        ] {
+            ds(&mut b, name, &[1], &value.to_bits().to_le_bytes());
+        }
         let tally = state.net_force.as_ref().expect("the sample records net forces");
         let walls = tally.wall_contact_n.len();
         ds(&mut b, "net_force/steps", &[1], &tally.steps.to_le_bytes());

@@ -11,6 +11,7 @@ pub mod error;
 pub mod gas;
 pub mod geometry;
 pub mod heat;
+pub mod heat_ledger;
 pub mod integrate;
 pub mod liquid;
 pub mod models;

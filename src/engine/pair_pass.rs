@@ -30,6 +30,7 @@ use super::cohesion::{Bond, BridgeConstants, Cohesion};
 use super::contacts::{AlignedHistory, ColumnsMut, split_at_ends};
 use super::geometry::Wall;
 use super::heat::HeatConfig;
+use super::heat_ledger::FixedPointSum;
 use super::integrate::{InverseInertia, half_kick_one};
 use super::liquid::BridgeCache;
 use super::models::history::{CohesionHistory, HistoryLayout, StaticLayout};
@@ -876,6 +877,8 @@ impl<'a> Context<'a> {
             let heat_flow_w = std::mem::replace(&mut channels.heat_flow_w[i], 0.0);
             if self.kick.is_some() {
                 motion.set_t(i, ti + self.dt_s * heat_flow_w * self.inv_thermal_mass_per_j_k[i]);
+                // The walls' share, for the energy ledger (`engine::heat_ledger`).
+                tally.wall_heat_flow_w.add(flows.heat_flow_w);
             }
         }
         let (x_new, v_new, w_new, d2) = self.finish(i, &mut f, &mut t, xi, vi, wi);
@@ -949,6 +952,8 @@ struct Tally {
     max_displacement2: f64,
     /// Square-well crossings.
     well_crossings: u64,
+    /// Heat flowing from the walls into the kicked particles, W (order-independent: the same bits on any threads).
+    wall_heat_flow_w: FixedPointSum,
 }
 
 impl Tally {
@@ -958,6 +963,7 @@ impl Tally {
         self.velocity_sum += later.velocity_sum;
         self.max_displacement2 = self.max_displacement2.max(later.max_displacement2);
         self.well_crossings += later.well_crossings;
+        self.wall_heat_flow_w.merge(later.wall_heat_flow_w);
     }
 }
 
@@ -968,6 +974,7 @@ impl Default for Tally {
             velocity_sum: 0.0,
             max_displacement2: 0.0,
             well_crossings: 0,
+            wall_heat_flow_w: FixedPointSum::default(),
         }
     }
 }
@@ -1000,6 +1007,8 @@ pub struct ForcePass {
     pub max_displacement2_m2: f64,
     /// Square-well crossings in this pass.
     pub well_crossings: u64,
+    /// With heat transfer and a kick: the heat flowing from the walls into the particles this step, W.
+    pub wall_heat_flow_w: f64,
 }
 
 /// Computes the forces and torques of every pair and wall slot into `p.force_n` and `p.torque_n_m` (adding onto
@@ -1241,6 +1250,7 @@ fn serial<P: PassKind>(
         non_finite: first_non_finite(tally.velocity_sum, velocity, omega, 0),
         max_displacement2_m2: tally.max_displacement2,
         well_crossings: tally.well_crossings,
+        wall_heat_flow_w: tally.wall_heat_flow_w.value(),
     }
 }
 
@@ -1371,7 +1381,7 @@ fn parallel<P: PassKind>(
         )
         .zip(hist_parts.into_iter().zip(wall_parts.into_iter().zip(channel_parts)))
         .collect();
-    let (worst_ranges, non_finite, max_d2, crossings_ranges) = team
+    let (worst_ranges, non_finite, max_d2, crossings_ranges, wall_heat) = team
         .map_parts(
             parts,
             |r, (((force, torque), (x, (v, (w, temperature)))), (pairs, (walls, channels)))| {
@@ -1403,14 +1413,19 @@ fn parallel<P: PassKind>(
             },
         )
         .into_iter()
-        .fold((WorstOverlap::NONE, None, 0.0f64, 0u64), |a, b| {
-            (a.0.max(b.0), a.1.min(b.1).or(a.1).or(b.1), a.2.max(b.2), a.3 + b.3)
-        });
+        .fold(
+            (WorstOverlap::NONE, None, 0.0f64, 0u64, FixedPointSum::default()),
+            |mut a, b| {
+                a.4.merge(b.4);
+                (a.0.max(b.0), a.1.min(b.1).or(a.1).or(b.1), a.2.max(b.2), a.3 + b.3, a.4)
+            },
+        );
     ForcePass {
         worst_overlap: worst_cross.max(worst_ranges),
         non_finite,
         max_displacement2_m2: max_d2,
         well_crossings: crossings_cross + crossings_ranges,
+        wall_heat_flow_w: wall_heat.value(),
     }
 }
 
@@ -1638,7 +1653,7 @@ fn range_sweep<P: PassKind>(
     (x, v, w, temperature): Motion4,
     mut pairs: ColumnsMut,
     mut walls: ColumnsMut,
-) -> (WorstOverlap, Option<usize>, f64, u64) {
+) -> (WorstOverlap, Option<usize>, f64, u64, FixedPointSum) {
     let (plan, list, buffers) = (range.plan, range.list, range.buffers);
     let (lo, hi) = (plan.bounds[r], plan.bounds[r + 1]);
     // Everything below is indexed relative to the range: particle il is lo + il, pair slot k is pair_base + k.
@@ -1710,5 +1725,6 @@ fn range_sweep<P: PassKind>(
         first_non_finite(tally.velocity_sum, v, w, lo),
         tally.max_displacement2,
         tally.well_crossings,
+        tally.wall_heat_flow_w,
     )
 }

@@ -14,6 +14,7 @@ use super::cohesion::CohesionEvents;
 pub use super::config::SimConfig;
 use super::contacts::AlignedHistory;
 use super::gas::coupled::GasCoupling;
+use super::heat_ledger::HeatLedger;
 use super::integrate::{InverseInertia, find_lost, kick_drift};
 use super::liquid::{BridgeCache, step_liquid, total_liquid_m3};
 use super::models::cohesion_law::CohesionModel;
@@ -112,6 +113,9 @@ pub struct Simulation {
     /// The net force on the particles by mechanism, summed every step when asked for
     /// ([`Simulation::record_net_forces`]); a diagnostic that never feeds back into the motion.
     pub net_force: Option<NetForceTally>,
+    /// The energy ledger of a run with heat transfer ([`Simulation::start_heat_ledger`], `engine::heat_ledger`); a
+    /// diagnostic that never feeds back into the motion or the temperatures.
+    pub heat_ledger: Option<HeatLedger>,
 
     // The workspace.
     /// What the engine keeps between steps only to go fast (rebuilt from the state on restore).
@@ -176,6 +180,7 @@ impl Simulation {
             sprayed_m3: 0.0,
             gas: None,
             net_force: None,
+            heat_ledger: None,
             timers: StageTimers::default(),
         };
         sim.refresh_neighbors();
@@ -205,6 +210,7 @@ impl Simulation {
             sprayed_m3: 0.0,
             gas: None,
             net_force: None,
+            heat_ledger: None,
             timers: StageTimers::default(),
         };
         sim.load(state)?;
@@ -223,6 +229,7 @@ impl Simulation {
         self.wall_angle_rad = state.wall_angle_rad;
         self.rng = state.rng;
         self.net_force = state.net_force;
+        self.heat_ledger = state.heat_ledger;
         self.work.bridges = BridgeCache::default();
         self.work.pending_drift = None;
         self.work.accumulators_zeroed = false;
@@ -283,6 +290,7 @@ impl Simulation {
             rng: self.rng,
             gas: self.gas.as_ref().map(|g| g.snapshot()),
             net_force: self.net_force.clone(),
+            heat_ledger: self.heat_ledger,
         }
     }
 
@@ -432,6 +440,13 @@ impl Simulation {
             self.work.bridges.forget_watch();
             self.timers.drying += t.elapsed();
         }
+        let budget = std::mem::take(&mut gas.heat_budget);
+        if let (Some(ledger), Some(heat)) = (self.heat_ledger.as_mut(), gas.heat) {
+            let c_g = heat.thermal.heat_capacity_j_per_kg_k;
+            ledger.gas_boundary_in_j += c_g * budget.boundary_in;
+            ledger.gas_boundary_out_j += c_g * budget.boundary_out;
+            ledger.gas_continuity_j += c_g * budget.continuity;
+        }
         self.timers.gas += t.elapsed();
         result.map_err(|detail| NumericalError::GasDiverged {
             step: self.step,
@@ -557,6 +572,9 @@ impl Simulation {
             tally.steps += 1;
         }
         let pass = self.forces(dt, Some(kick));
+        if let Some(ledger) = self.heat_ledger.as_mut() {
+            ledger.wall_to_particles_j += dt * pass.wall_heat_flow_w;
+        }
         if fuse_next_drift {
             self.work.pending_drift = Some(pass.max_displacement2_m2);
         }
@@ -703,6 +721,44 @@ impl Simulation {
         let now = liquid_kg + gas.vapour_kg()? + l.vapour_out_kg - l.vapour_in_kg;
         let start = l.initial_liquid_kg + l.initial_vapour_kg + l.sprayed_kg;
         Some(now / start - 1.0)
+    }
+
+    /// Starts the energy ledger from the present state (a new run with heat transfer, once its gas is attached; a
+    /// restored run keeps its checkpointed ledger). Without heat transfer it does nothing.
+    pub fn start_heat_ledger(&mut self) {
+        if self.config.heat.is_some() {
+            self.heat_ledger = Some(HeatLedger::default());
+            let held = self.held_energy_j();
+            if let (Some(ledger), Some(held)) = (self.heat_ledger.as_mut(), held) {
+                ledger.initial_energy_j = held;
+            }
+        }
+    }
+
+    /// The energy the run holds now (`engine::heat_ledger`): the particles' Σ m c_p T, the gas's Σ ε ρ c_g T V and
+    /// the convection it has still to receive at its next step, and the latent heat of the liquid evaporated net,
+    /// J (`None` without heat transfer).
+    pub fn held_energy_j(&self) -> Option<f64> {
+        let heat = self.config.heat.as_ref()?;
+        let p = &self.particles;
+        let particles: f64 = (0..p.len())
+            .map(|i| p.mass_kg[i] * heat.heat_capacity_j_per_kg_k[p.species[i].index()] * p.temperature_k[i])
+            .sum();
+        let gas = self.gas.as_ref().map_or(0.0, |g| {
+            let latent = g
+                .drying
+                .as_ref()
+                .map_or(0.0, |d| d.config.latent_heat_j_per_kg * d.ledger.evaporated_kg);
+            g.thermal_energy_j().unwrap_or(0.0) + g.pending_convection_j(self.dt_s).unwrap_or(0.0) + latent
+        });
+        Some(particles + gas)
+    }
+
+    /// The energy ledger's closure: the energy held now over the start plus all that crossed into the run, minus 1
+    /// (`None` without heat transfer).
+    pub fn energy_closure(&self) -> Option<f64> {
+        let ledger = self.heat_ledger.as_ref()?;
+        Some(self.held_energy_j()? / ledger.expected_energy_j() - 1.0)
     }
 
     /// Liquid on the particles plus liquid in bridges, m³.

@@ -9,6 +9,7 @@ use super::Vec3;
 use super::channels::CHANNELS;
 use super::contacts::ContactStore;
 use super::gas::coupled::GasSnapshot;
+use super::heat_ledger::HeatLedger;
 use super::models::ContactHistory;
 use super::models::history::{FieldValue, HISTORY_FIELDS};
 use super::net_force::NetForceTally;
@@ -61,6 +62,8 @@ pub struct SimState {
     /// The net-force sums since the last series row, when the run records them (a diagnostic, but a run resumed
     /// from here must write the same rows).
     pub net_force: Option<NetForceTally>,
+    /// The energy ledger of a run with heat transfer (`engine::heat_ledger`).
+    pub heat_ledger: Option<HeatLedger>,
 }
 
 /// Bit-level comparison of two states: `None` when every value is identical to the bit (`to_bits()` for floats),
@@ -226,6 +229,38 @@ pub fn first_difference(a: &SimState, b: &SimState) -> Option<String> {
         }
         (None, None) => {}
         _ => return Some("net_force: present in one state only".into()),
+    }
+    match (&a.heat_ledger, &b.heat_ledger) {
+        (Some(x), Some(y)) => {
+            let totals = f("heat_ledger.initial_energy_j", x.initial_energy_j, y.initial_energy_j)
+                .or_else(|| {
+                    f(
+                        "heat_ledger.wall_to_particles_j",
+                        x.wall_to_particles_j,
+                        y.wall_to_particles_j,
+                    )
+                })
+                .or_else(|| {
+                    f(
+                        "heat_ledger.gas_boundary_in_j",
+                        x.gas_boundary_in_j,
+                        y.gas_boundary_in_j,
+                    )
+                })
+                .or_else(|| {
+                    f(
+                        "heat_ledger.gas_boundary_out_j",
+                        x.gas_boundary_out_j,
+                        y.gas_boundary_out_j,
+                    )
+                })
+                .or_else(|| f("heat_ledger.gas_continuity_j", x.gas_continuity_j, y.gas_continuity_j));
+            if totals.is_some() {
+                return totals;
+            }
+        }
+        (None, None) => {}
+        _ => return Some("heat_ledger: present in one state only".into()),
     }
     f("time_s", a.time_s, b.time_s)
         .or_else(|| f("dt_s", a.dt_s, b.dt_s))

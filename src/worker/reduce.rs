@@ -176,6 +176,17 @@ pub fn metrics(job: &JobSpec, built: &BuiltScenario, sim: &Simulation, series: &
         ))
     };
     let mean_temperatures = || series.column("mean_temperature_k").filter(|t| !t.is_empty());
+    // The largest |value| of a ledger's closure column (NaN rows, e.g. a ledger not yet started, make it NaN).
+    let largest_magnitude = |name: &str| {
+        series
+            .column(name)
+            .and_then(|c| {
+                c.iter()
+                    .map(|v| v.abs())
+                    .reduce(|a, b| if a.is_nan() || b.is_nan() { f64::NAN } else { a.max(b) })
+            })
+            .unwrap_or(f64::NAN)
+    };
     let coldest = || {
         let (t, temperature) = (series.column("time_s")?, series.column("mean_temperature_k")?);
         (0..t.len())
@@ -315,10 +326,8 @@ pub fn metrics(job: &JobSpec, built: &BuiltScenario, sim: &Simulation, series: &
                 JobMetric::TemperatureRiseAfterMinimum => mean_temperatures()
                     .zip(coldest())
                     .map_or(f64::NAN, |(t, (_, min))| t[t.len() - 1] - min),
-                JobMetric::DryingLedgerClosure => series
-                    .column("drying_closure")
-                    .and_then(|c| c.iter().map(|v| v.abs()).reduce(f64::max))
-                    .unwrap_or(f64::NAN),
+                JobMetric::DryingLedgerClosure => largest_magnitude("drying_closure"),
+                JobMetric::EnergyLedgerClosure => largest_magnitude("energy_closure"),
             };
             Metric {
                 name: metric.name().to_string(),

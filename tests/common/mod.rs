@@ -109,13 +109,19 @@ seed: 5
 
 /// The scenario's simulation with its gas attached.
 pub fn with_gas(b: &BuiltScenario) -> Simulation {
-    let mut sim = simulation(b, 1);
+    with_gas_on(b, 1)
+}
+
+/// The scenario's simulation on `threads` with its gas attached and its ledgers started, as a new run starts.
+pub fn with_gas_on(b: &BuiltScenario, threads: usize) -> Simulation {
+    let mut sim = simulation(b, threads);
     if let Some(setup) = &b.gas {
         let p = &sim.particles;
         let gas = setup.coupling(&p.position_m, &p.radius_m).expect("the gas builds");
         sim.attach_gas(gas);
         sim.start_drying_ledger();
     }
+    sim.start_heat_ledger();
     sim
 }
 

@@ -119,6 +119,9 @@ pub struct GasCoupling {
     /// With drying, the porosity before and the mass flows of the gas step just taken, for the drying step that
     /// follows it (workspace).
     pub(crate) step_flows: Option<(Vec<f64>, [Vec<f64>; 3])>,
+    /// The temperature's budget (K·kg) over the gas steps since the simulation last took it for its energy
+    /// ledger (workspace: taken after every gas step).
+    pub(crate) heat_budget: super::transported_scalar::ScalarBudget,
 }
 
 impl GasCoupling {
@@ -167,6 +170,7 @@ impl GasCoupling {
             heat: None,
             drying: None,
             step_flows: None,
+            heat_budget: Default::default(),
         })
     }
 
@@ -264,15 +268,19 @@ impl GasCoupling {
         }
         if !self.scalars.is_empty() {
             let mass_flow = self.solver.mass_flow_kg_per_s();
-            for scalar in &mut self.scalars {
+            let temperature = self.heat.map(|h| h.temperature.index());
+            for (k, scalar) in self.scalars.iter_mut().enumerate() {
                 if scalar.spec.exchange == super::transported_scalar::ScalarExchange::Evaporation {
                     // Stepped by the drying step, with the particles.
                     continue;
                 }
                 let t = std::time::Instant::now();
-                let r = scalar.step(&self.solver, &old_porosity, &mass_flow, dt_s)?;
+                let (r, budget) = scalar.step(&self.solver, &old_porosity, &mass_flow, dt_s)?;
                 self.linear_solve_s += t.elapsed().as_secs_f64();
                 linear_iterations += r.iterations as u64;
+                if temperature == Some(k) {
+                    self.heat_budget.add(budget);
+                }
             }
             if self.drying.is_some() {
                 self.step_flows = Some((old_porosity, mass_flow));

@@ -120,6 +120,15 @@ impl GasCoupling {
         )
     }
 
+    /// The heat the particles' convection has handed the gas since its last step, which the gas takes in at its
+    /// next one: c_g V Δt_DEM Σ (gathered transfer), J (`None` without heat).
+    pub fn pending_convection_j(&self, dem_dt_s: f64) -> Option<f64> {
+        let heat = self.heat?;
+        let per_volume = self.solver.config.grid.cell_volume_m3() * heat.thermal.heat_capacity_j_per_kg_k;
+        let transfer: f64 = self.scalar(heat.temperature).exchange.transfer_sum.iter().sum();
+        Some(per_volume * dem_dt_s * transfer)
+    }
+
     /// The gas's mean temperature weighted by its mass in each cell, Σ ε T / Σ ε over the cells outside blocked
     /// ones, K (`None` without heat).
     pub fn mean_temperature_k(&self) -> Option<f64> {
