@@ -99,6 +99,14 @@ pub enum Command {
         #[arg(long, value_enum, default_value = "table")]
         format: Format,
     },
+    /// Pictures of a campaign's results (PNG and SVG, written inside the campaign's `plots/` unless --out says
+    /// where); prints the files written.
+    Plot {
+        /// The campaign directory.
+        dir: PathBuf,
+        #[command(subcommand)]
+        picture: PlotPicture,
+    },
     /// Parameters and metrics, one row per job.
     Export {
         /// The campaign directory.
@@ -159,6 +167,31 @@ pub enum Command {
         watch_stdin: bool,
         #[arg(long)]
         max_steps: Option<u64>,
+    },
+}
+
+/// The pictures `granflow plot` draws.
+#[derive(Debug, Subcommand)]
+pub enum PlotPicture {
+    /// A phase diagram: one metric over two swept parameters as a coloured map, the value in each cell, a colour bar
+    /// with the metric's unit.
+    Phase {
+        /// The parameter along x (a swept path or its unique last key).
+        #[arg(long)]
+        x: String,
+        /// The parameter along y.
+        #[arg(long)]
+        y: String,
+        /// The metric in the cells (the mean over jobs that share a cell).
+        #[arg(long)]
+        metric: String,
+        /// Only jobs whose parameter has this value (repeatable), as `query --pivot --where`.
+        #[arg(long = "where", value_name = "PARAM=VALUE")]
+        filters: Vec<String>,
+        /// Output file: `.png` or `.svg` for that format only, otherwise a stem given both extensions (default
+        /// <dir>/plots/phase-<metric>-<x>-<y>).
+        #[arg(long)]
+        out: Option<PathBuf>,
     },
 }
 
@@ -368,6 +401,20 @@ pub fn run(cli: Cli) -> Result<i32> {
             let loaded = crate::campaign_dir::load_stored_campaign(&dir)?;
             let source = crate::campaign_dir::spec_copy_path(&dir);
             dispatch_campaign(&loaded, &source, &dir, dispatch, false)
+        }
+        Command::Plot { dir, picture } => {
+            let written = match picture {
+                PlotPicture::Phase {
+                    x,
+                    y,
+                    metric,
+                    filters,
+                    out,
+                } => crate::plot::phase(&dir, &x, &y, &metric, &filters, out.as_deref())?,
+            };
+            let list: Vec<String> = written.iter().map(|p| p.display().to_string()).collect();
+            emit(&list.join("\n"))?;
+            Ok(0)
         }
         Command::Status { dir } => {
             emit(&inspect::status(&dir)?)?;

@@ -153,11 +153,11 @@ fn resolve_param(store: &Store, name: &str) -> Result<String, Error> {
         .collect();
     match matches.as_slice() {
         [one] => Ok((*one).clone()),
-        [] => Err(Error::External(format!(
+        [] => Err(Error::Usage(format!(
             "no swept parameter `{name}`; the sweep sets: {}",
             names.join(", ")
         ))),
-        several => Err(Error::External(format!(
+        several => Err(Error::Usage(format!(
             "`{name}` is ambiguous: {}",
             several.iter().map(|s| s.as_str()).collect::<Vec<_>>().join(", ")
         ))),
@@ -166,12 +166,30 @@ fn resolve_param(store: &Store, name: &str) -> Result<String, Error> {
 
 /// `granflow query --pivot X Y --metric M`.
 pub fn pivot(dir: &Path, x: &str, y: &str, metric: &str, filters: &[String], format: Format) -> Result<String, Error> {
-    let (store, id, _) = open(dir)?;
+    let (p, _) = pivot_of(dir, x, y, metric, filters)?;
+    Ok(match format {
+        Format::Table => p.to_table(),
+        Format::Csv => p.to_csv(),
+        Format::Json => p.to_json(),
+    })
+}
+
+/// The pivot of `metric` over parameters `x` and `y` (swept paths or their unique last keys) of the campaign in
+/// `dir`, of only the jobs matching `filters` (`PARAM=VALUE`), with the campaign: `query --pivot` and `plot`.
+/// A name that is not swept, an ambiguous one, an unknown metric or a malformed filter is a usage error (exit 2).
+pub(crate) fn pivot_of(
+    dir: &Path,
+    x: &str,
+    y: &str,
+    metric: &str,
+    filters: &[String],
+) -> Result<(store::Pivot, Campaign), Error> {
+    let (store, id, campaign) = open(dir)?;
     let (x, y) = (resolve_param(&store, x)?, resolve_param(&store, y)?);
     let mut wanted = Vec::new();
     for filter in filters {
         let Some((name, value)) = filter.split_once('=') else {
-            return Err(Error::External(format!(
+            return Err(Error::Usage(format!(
                 "--where `{filter}`: expected PARAM=VALUE, e.g. radius_m=0.00135"
             )));
         };
@@ -181,12 +199,13 @@ pub fn pivot(dir: &Path, x: &str, y: &str, metric: &str, filters: &[String], for
         };
         wanted.push((resolve_param(&store, name.trim())?, value));
     }
-    let p = store.pivot_where(id, &x, &y, metric, &wanted).map_err(store_err)?;
-    Ok(match format {
-        Format::Table => p.to_table(),
-        Format::Csv => p.to_csv(),
-        Format::Json => p.to_json(),
-    })
+    let p = store.pivot_where(id, &x, &y, metric, &wanted).map_err(|e| match e {
+        store::StoreError::UnknownParameter { .. }
+        | store::StoreError::UnknownMetric { .. }
+        | store::StoreError::InvalidQuery { .. } => Error::Usage(e.to_string()),
+        other => store_err(other),
+    })?;
+    Ok((p, campaign))
 }
 
 /// `granflow query --sql`.

@@ -22,6 +22,7 @@ pub mod inspect;
 pub mod machine;
 mod models_doc;
 pub mod orchestrate;
+pub mod plot;
 pub mod provenance;
 pub mod report;
 pub mod scenario;

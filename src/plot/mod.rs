@@ -1,0 +1,197 @@
+//! `granflow plot`: pictures of a campaign's results, as PNG and SVG, drawn in Rust (plotters; text by ab_glyph from
+//! the embedded DejaVu Sans, so nothing beyond the binary is needed).
+//!
+//! - `phase_diagram.rs`: one metric over two swept parameters as a coloured map.
+//! - `units.rs`: a parameter's unit from its SI suffix, for the captions.
+//!
+//! Every picture is written to a temporary file beside its destination and renamed into place, so a failure leaves
+//! nothing half-written; bad requests (an unknown parameter or metric, a campaign with no finished job that has the
+//! metric, an output path that cannot be written) fail before anything is drawn, with exit code 2.
+
+pub mod phase_diagram;
+pub mod units;
+
+use std::io::Write;
+use std::path::{Path, PathBuf};
+use std::sync::Once;
+
+use plotters::prelude::*;
+
+use crate::error::Error;
+
+/// The picture formats.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum PictureFormat {
+    Png,
+    Svg,
+}
+
+impl PictureFormat {
+    fn extension(self) -> &'static str {
+        match self {
+            PictureFormat::Png => "png",
+            PictureFormat::Svg => "svg",
+        }
+    }
+}
+
+/// Makes DejaVu Sans the "sans-serif" every picture uses (once per process).
+fn register_fonts() {
+    static FONTS: Once = Once::new();
+    FONTS.call_once(|| {
+        for (style, bytes) in [
+            (FontStyle::Normal, dejavu::sans::regular()),
+            (FontStyle::Bold, dejavu::sans::bold()),
+            (FontStyle::Oblique, dejavu::sans::oblique()),
+            (FontStyle::Italic, dejavu::sans::oblique()),
+        ] {
+            plotters::style::register_font("sans-serif", style, bytes)
+                .unwrap_or_else(|_| panic!("the embedded DejaVu Sans is a valid font"));
+        }
+    });
+}
+
+/// The files a picture goes to: `out` as given when it ends in `.png` or `.svg` (that format only), otherwise
+/// `out` (or `default_stem` inside the campaign's `plots/` directory) with each extension.
+pub fn outputs(dir: &Path, out: Option<&Path>, default_stem: &str) -> Vec<(PathBuf, PictureFormat)> {
+    let base = out.map_or_else(|| dir.join("plots").join(default_stem), Path::to_path_buf);
+    match base.extension().and_then(|e| e.to_str()) {
+        Some("png") => vec![(base, PictureFormat::Png)],
+        Some("svg") => vec![(base, PictureFormat::Svg)],
+        _ => [PictureFormat::Png, PictureFormat::Svg]
+            .into_iter()
+            .map(|f| {
+                let mut name = base.as_os_str().to_os_string();
+                name.push(".");
+                name.push(f.extension());
+                (PathBuf::from(name), f)
+            })
+            .collect(),
+    }
+}
+
+/// A file name part from a metric or parameter name (dots and brackets to dashes).
+pub fn file_part(name: &str) -> String {
+    name.chars()
+        .map(|c| {
+            if c.is_ascii_alphanumeric() || c == '_' || c == '-' {
+                c
+            } else {
+                '-'
+            }
+        })
+        .collect::<String>()
+        .trim_matches('-')
+        .to_string()
+}
+
+/// Checks before drawing that each output's directory exists or can be made and takes a file (exit 2 otherwise).
+fn check_writable(outputs: &[(PathBuf, PictureFormat)]) -> Result<(), Error> {
+    for (path, _) in outputs {
+        let parent = path
+            .parent()
+            .filter(|p| !p.as_os_str().is_empty())
+            .unwrap_or(Path::new("."));
+        std::fs::create_dir_all(parent).map_err(|e| {
+            Error::Usage(format!(
+                "cannot write {}: making {}: {e}",
+                path.display(),
+                parent.display()
+            ))
+        })?;
+        tempfile::NamedTempFile::new_in(parent)
+            .and_then(|mut f| f.write_all(b""))
+            .map_err(|e| Error::Usage(format!("cannot write {}: {e}", path.display())))?;
+        if path.is_dir() {
+            return Err(Error::Usage(format!(
+                "cannot write {}: it is a directory",
+                path.display()
+            )));
+        }
+    }
+    Ok(())
+}
+
+/// Draws each of `outputs` at `size` (PNG by `draw_png`, SVG by `draw_svg`: the same drawing on two backends)
+/// through a temporary file renamed into place.
+fn write_pictures(
+    outputs: &[(PathBuf, PictureFormat)],
+    size: (u32, u32),
+    draw_png: impl Fn(&DrawingArea<BitMapBackend<'_>, plotters::coord::Shift>) -> Result<(), String>,
+    draw_svg: impl Fn(&DrawingArea<SVGBackend<'_>, plotters::coord::Shift>) -> Result<(), String>,
+) -> Result<Vec<PathBuf>, Error> {
+    register_fonts();
+    let mut written = Vec::new();
+    for (path, format) in outputs {
+        let parent = path
+            .parent()
+            .filter(|p| !p.as_os_str().is_empty())
+            .unwrap_or(Path::new("."));
+        let temp = tempfile::Builder::new()
+            .prefix(".granflow-plot-")
+            .suffix(&format!(".{}", format.extension()))
+            .tempfile_in(parent)
+            .map_err(|e| Error::Usage(format!("cannot write {}: {e}", path.display())))?;
+        let drawn = match format {
+            PictureFormat::Png => {
+                let root = BitMapBackend::new(temp.path(), size).into_drawing_area();
+                draw_png(&root).and_then(|()| root.present().map_err(|e| e.to_string()))
+            }
+            PictureFormat::Svg => {
+                let root = SVGBackend::new(temp.path(), size).into_drawing_area();
+                draw_svg(&root).and_then(|()| root.present().map_err(|e| e.to_string()))
+            }
+        };
+        drawn.map_err(|e| Error::External(format!("drawing {}: {e}", path.display())))?;
+        temp.persist(path).map_err(|e| Error::Io {
+            action: "writing picture",
+            path: path.clone(),
+            source: e.error,
+        })?;
+        written.push(path.clone());
+    }
+    Ok(written)
+}
+
+/// `granflow plot <dir> phase`: `metric` over `x` (columns) and `y` (rows) of the done jobs matching `filters`.
+/// Returns the files written.
+pub fn phase(
+    dir: &Path,
+    x: &str,
+    y: &str,
+    metric: &str,
+    filters: &[String],
+    out: Option<&Path>,
+) -> Result<Vec<PathBuf>, Error> {
+    let (pivot, campaign) = crate::inspect::pivot_of(dir, x, y, metric, filters)?;
+    if !pivot.cells.iter().flatten().flatten().any(|c| c.mean.is_finite()) {
+        return Err(Error::Usage(format!(
+            "campaign {}: no finished job has a value of `{metric}`{} (see `granflow status {}`)",
+            campaign.spec.name,
+            if filters.is_empty() {
+                String::new()
+            } else {
+                format!(" where {}", filters.join(", "))
+            },
+            dir.display()
+        )));
+    }
+    let stem = format!(
+        "phase-{}-{}-{}",
+        file_part(metric),
+        file_part(&pivot.x_param),
+        file_part(&pivot.y_param)
+    );
+    let outputs = outputs(dir, out, &stem);
+    check_writable(&outputs)?;
+    let mut title = format!("{} — {}", pivot.metric, campaign.spec.name);
+    if !filters.is_empty() {
+        title.push_str(&format!(" ({})", filters.join(", ")));
+    }
+    write_pictures(
+        &outputs,
+        phase_diagram::SIZE,
+        |root| phase_diagram::draw(root, &pivot, &title),
+        |root| phase_diagram::draw(root, &pivot, &title),
+    )
+}

@@ -1,0 +1,237 @@
+//! A phase diagram: one metric over two swept parameters as a coloured map (`granflow plot <dir> phase`), drawn on
+//! any plotters backend (PNG and SVG from the same code).
+//!
+//! One cell per swept value on each axis, in the sweep's sorted order, labelled with the values themselves: for a
+//! linspace sweep that is a linear axis, for a logspace sweep a logarithmic one (the caption says "log scale" when
+//! the values are geometric), and any other list is shown as the categories it is. Each cell holds the metric's mean
+//! over the done jobs that share it, coloured on viridis and written in the cell (with "×n" when it averages n
+//! jobs); an empty cell (no done job, or the metric NaN) is grey and marked "–". A colour bar on the right gives
+//! the scale and the metric's unit.
+
+use plotters::coord::Shift;
+use plotters::coord::ranged1d::SegmentValue;
+use plotters::prelude::*;
+use plotters::style::colors::colormaps::ViridisRGB;
+
+use super::units::{caption, parameter_unit};
+use crate::store::{ParamValue, Pivot};
+
+/// The picture's size in pixels (PNG) or user units (SVG).
+pub const SIZE: (u32, u32) = (1200, 900);
+
+/// Geometric spacing within this relative tolerance makes a logspace axis.
+const GEOMETRIC_TOLERANCE: f64 = 1e-6;
+
+/// A parameter value as the axis writes it: numbers to 4 significant digits, texts as they are.
+pub fn value_label(value: &ParamValue) -> String {
+    match value {
+        ParamValue::Real(v) => significant(*v, 4),
+        ParamValue::Text(t) => t.clone(),
+    }
+}
+
+/// `v` to `digits` significant digits, without trailing zeros; exponent form beyond 1e-3..1e5.
+pub fn significant(v: f64, digits: usize) -> String {
+    if !v.is_finite() {
+        return v.to_string();
+    }
+    if v == 0.0 {
+        return "0".into();
+    }
+    let magnitude = v.abs().log10().floor() as i32;
+    if !(-3..5).contains(&magnitude) {
+        let text = format!("{:.*e}", digits.saturating_sub(1), v);
+        let (mantissa, exponent) = text.split_once('e').unwrap_or((&text, "0"));
+        let mantissa = mantissa.trim_end_matches('0').trim_end_matches('.');
+        return format!("{mantissa}e{exponent}");
+    }
+    let decimals = (digits as i32 - 1 - magnitude).max(0) as usize;
+    let text = format!("{v:.decimals$}");
+    if text.contains('.') {
+        text.trim_end_matches('0').trim_end_matches('.').to_string()
+    } else {
+        text
+    }
+}
+
+/// Whether the numbers of an axis are log-spaced (at least three, all positive, one ratio).
+fn is_geometric(values: &[ParamValue]) -> bool {
+    let numbers: Vec<f64> = values
+        .iter()
+        .filter_map(|v| match v {
+            ParamValue::Real(x) => Some(*x),
+            _ => None,
+        })
+        .collect();
+    if numbers.len() < 3 || numbers.len() != values.len() || numbers.iter().any(|&x| x <= 0.0) {
+        return false;
+    }
+    let ratio = numbers[1] / numbers[0];
+    ratio > 1.0 + GEOMETRIC_TOLERANCE
+        && numbers
+            .windows(2)
+            .all(|w| ((w[1] / w[0]) / ratio - 1.0).abs() < GEOMETRIC_TOLERANCE)
+}
+
+/// The axis caption: the parameter's name with its unit, and "log scale" for a logspace sweep.
+fn axis_caption(name: &str, values: &[ParamValue]) -> String {
+    let text = caption(name, parameter_unit(name));
+    if is_geometric(values) {
+        format!("{text} (log scale)")
+    } else {
+        text
+    }
+}
+
+/// The colour of `value` on the map from `lo` to `hi`.
+fn colour(value: f64, lo: f64, hi: f64) -> RGBColor {
+    if hi > lo {
+        ViridisRGB.get_color_normalized(value as f32, lo as f32, hi as f32)
+    } else {
+        ViridisRGB.get_color(0.5)
+    }
+}
+
+/// Black or white, whichever reads on `background`.
+fn text_colour(background: &RGBColor) -> RGBColor {
+    let luminance = 0.299 * f64::from(background.0) + 0.587 * f64::from(background.1) + 0.114 * f64::from(background.2);
+    if luminance > 140.0 { BLACK } else { WHITE }
+}
+
+type DrawResult = Result<(), String>;
+
+fn err<E: std::fmt::Display>(e: E) -> String {
+    e.to_string()
+}
+
+/// Draws `pivot` (its metric's values over its two parameters) on `root`, titled `title`.
+pub fn draw<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, pivot: &Pivot, title: &str) -> DrawResult {
+    root.fill(&WHITE).map_err(err)?;
+    let values: Vec<f64> = pivot.cells.iter().flatten().flatten().map(|c| c.mean).collect();
+    let (lo, hi) = values.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), &v| {
+        (lo.min(v), hi.max(v))
+    });
+    let (width, _) = root.dim_in_pixel();
+    let (map_area, bar_area) = root.split_horizontally(width * 82 / 100);
+    // A discrete range is inclusive of its end in plotters: 0..n−1 makes the n cells.
+    let (nx, ny) = (pivot.x_values.len().max(1), pivot.y_values.len().max(1));
+    let x_labels: Vec<String> = pivot.x_values.iter().map(value_label).collect();
+    let y_labels: Vec<String> = pivot.y_values.iter().map(value_label).collect();
+    let label = |labels: &[String], v: &SegmentValue<usize>| match v {
+        SegmentValue::CenterOf(i) => labels.get(*i).cloned().unwrap_or_default(),
+        _ => String::new(),
+    };
+    let mut chart = ChartBuilder::on(&map_area)
+        .caption(title, ("sans-serif", 26))
+        .margin(20)
+        .x_label_area_size(70)
+        .y_label_area_size(110)
+        .build_cartesian_2d((0..nx - 1).into_segmented(), (0..ny - 1).into_segmented())
+        .map_err(err)?;
+    chart
+        .configure_mesh()
+        .disable_mesh()
+        .x_labels(nx + 1)
+        .y_labels(ny + 1)
+        .x_label_formatter(&|v| label(&x_labels, v))
+        .y_label_formatter(&|v| label(&y_labels, v))
+        .x_desc(axis_caption(&pivot.x_param, &pivot.x_values))
+        .y_desc(axis_caption(&pivot.y_param, &pivot.y_values))
+        .label_style(("sans-serif", 18))
+        .axis_desc_style(("sans-serif", 20))
+        .draw()
+        .map_err(err)?;
+    let cell_font = if nx.max(ny) > 12 { 12 } else { 18 };
+    for (row, cells) in pivot.cells.iter().enumerate() {
+        for (column, cell) in cells.iter().enumerate() {
+            let corners = [
+                (SegmentValue::Exact(column), SegmentValue::Exact(row)),
+                (SegmentValue::Exact(column + 1), SegmentValue::Exact(row + 1)),
+            ];
+            let centre = (SegmentValue::CenterOf(column), SegmentValue::CenterOf(row));
+            let (fill, text) = match cell {
+                Some(c) => {
+                    let fill = colour(c.mean, lo, hi);
+                    let mut text = significant(c.mean, 3);
+                    if c.count > 1 {
+                        text.push_str(&format!(" ×{}", c.count));
+                    }
+                    (fill, text)
+                }
+                None => (RGBColor(215, 215, 215), "–".to_string()),
+            };
+            chart
+                .draw_series(std::iter::once(Rectangle::new(corners, fill.filled())))
+                .map_err(err)?;
+            let ink = text_colour(&fill);
+            let style = TextStyle::from(("sans-serif", cell_font).into_font()).color(&ink).pos(
+                plotters::style::text_anchor::Pos::new(
+                    plotters::style::text_anchor::HPos::Center,
+                    plotters::style::text_anchor::VPos::Center,
+                ),
+            );
+            chart
+                .draw_series(std::iter::once(Text::new(text, centre, style)))
+                .map_err(err)?;
+        }
+    }
+    draw_colour_bar(&bar_area, lo, hi, &caption(&pivot.metric, Some(&pivot.unit)))
+}
+
+/// A vertical bar of the map from `lo` (bottom) to `hi` (top) with its scale and `label`.
+fn draw_colour_bar<DB: DrawingBackend>(area: &DrawingArea<DB, Shift>, lo: f64, hi: f64, label: &str) -> DrawResult {
+    let (lo, hi) = if hi > lo {
+        (lo, hi)
+    } else {
+        (lo - 0.5 * lo.abs().max(1.0), hi + 0.5 * hi.abs().max(1.0))
+    };
+    let mut chart = ChartBuilder::on(area)
+        .margin_top(70)
+        .margin_bottom(90)
+        .margin_right(10)
+        .y_label_area_size(80)
+        .build_cartesian_2d(0.0..1.0, lo..hi)
+        .map_err(err)?;
+    chart
+        .configure_mesh()
+        .disable_mesh()
+        .disable_x_axis()
+        .y_labels(6)
+        .y_label_formatter(&|v| significant(*v, 3))
+        .y_desc(label)
+        .label_style(("sans-serif", 16))
+        .axis_desc_style(("sans-serif", 18))
+        .draw()
+        .map_err(err)?;
+    const STEPS: usize = 100;
+    let step = (hi - lo) / STEPS as f64;
+    chart
+        .draw_series((0..STEPS).map(|k| {
+            let v0 = lo + k as f64 * step;
+            Rectangle::new([(0.0, v0), (1.0, v0 + step)], colour(v0 + 0.5 * step, lo, hi).filled())
+        }))
+        .map_err(err)?;
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn numbers_are_written_to_significant_digits() {
+        assert_eq!(significant(0.0015, 4), "0.0015");
+        assert_eq!(significant(373.15, 4), "373.1");
+        assert_eq!(significant(1.5e-6, 3), "1.5e-6");
+        assert_eq!(significant(2.0, 3), "2");
+        assert_eq!(significant(123456.0, 3), "1.23e5");
+    }
+
+    #[test]
+    fn a_logspace_sweep_is_geometric_and_a_linspace_one_is_not() {
+        let reals = |v: &[f64]| v.iter().map(|&x| ParamValue::Real(x)).collect::<Vec<_>>();
+        assert!(is_geometric(&reals(&[0.01, 0.1, 1.0, 10.0])));
+        assert!(!is_geometric(&reals(&[1.0, 2.0, 3.0])));
+        assert!(!is_geometric(&reals(&[0.1, 1.0])));
+    }
+}

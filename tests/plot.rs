@@ -1,0 +1,226 @@
+//! `granflow plot` through the real binary on a small finished campaign: a phase diagram as PNG (of the stated size,
+//! pixels not uniform) and SVG (holding the axis captions, the units and the parameter values as text), the paths
+//! printed; and the bad requests (an unknown metric or parameter, a campaign with no finished jobs, an output path
+//! that cannot be written) exit 2 with a clear message and write nothing.
+
+mod common;
+
+use std::path::Path;
+
+use common::granflow;
+
+/// A small drum campaign: 3 log-spaced speeds × 2 fill levels, a few hundred steps each.
+const CAMPAIGN: &str = r#"
+name: plot-mini
+seed: 3
+base:
+  domain: { lo_m: [-0.021, -0.021, 0.0], hi_m: [0.021, 0.021, 0.0064], periodic: [false, false, true] }
+  gravity: { vector_m_per_s2: [0.0, -9.81, 0.0] }
+  species:
+    - { name: red, radius_m: 0.0015, density_kg_per_m3: 2500.0, youngs_modulus_pa: 5.0e6, poisson_ratio: 0.3, friction_coefficient: 0.4 }
+    - { name: blue, radius_m: 0.0015, density_kg_per_m3: 2500.0, youngs_modulus_pa: 5.0e6, poisson_ratio: 0.3, friction_coefficient: 0.4 }
+  contact: { normal: { hertz: { restitution: 0.7 } }, tangential: mindlin }
+  walls:
+    - drum: { name: drum, species: red, axis_point_m: [0.0, 0.0, 0.0], axis: [0.0, 0.0, 1.0], radius_m: 0.02, rotation_rpm: 30.0 }
+  fill:
+    - lattice: { species: red, spacing_m: 0.0032, lo_m: [-0.02, -0.02, 0.0], hi_m: [0.0, 0.0, 0.0064], origin_m: [0.0016, 0.0016, 0.0016], inside_drum: drum }
+    - lattice: { species: blue, spacing_m: 0.0032, lo_m: [0.0, -0.02, 0.0], hi_m: [0.02, 0.0, 0.0064], origin_m: [0.0016, 0.0016, 0.0016], inside_drum: drum }
+  time: { dt_s: 2.0e-5, end_time_s: 0.01 }
+  output: { series_every_steps: 100 }
+sweep:
+  grid:
+    - { param: walls.0.drum.rotation_rpm, name: rotation_rpm, values: [10.0, 20.0, 40.0] }
+    - zip:
+        - { param: fill.0.lattice.hi_m.1, name: fill_top_m, values: [-0.006, 0.0] }
+        - { param: fill.1.lattice.hi_m.1, values: [-0.006, 0.0] }
+metrics: [kinetic_energy_j, coordination_number]
+executor: { local: { max_parallel: 2 } }
+"#;
+
+fn run_ok(args: &[&str], cwd: &Path) -> String {
+    let out = granflow(args, cwd);
+    assert!(
+        out.status.success(),
+        "granflow {args:?} failed: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    String::from_utf8_lossy(&out.stdout).into_owned()
+}
+
+fn fails_with_2(args: &[&str], cwd: &Path, message: &str) {
+    let out = granflow(args, cwd);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "granflow {args:?}: {stderr}");
+    assert!(
+        stderr.contains(message),
+        "granflow {args:?}: expected `{message}` in: {stderr}"
+    );
+}
+
+#[test]
+fn a_phase_diagram_is_drawn_as_png_and_svg_and_bad_requests_exit_2() {
+    let tmp = tempfile::tempdir().expect("temp dir");
+    let dir = tmp.path();
+    std::fs::write(dir.join("c.yaml"), CAMPAIGN).unwrap();
+    run_ok(&["run", "c.yaml", "--out", "c"], dir);
+
+    let printed = run_ok(
+        &[
+            "plot",
+            "c",
+            "phase",
+            "--x",
+            "rotation_rpm",
+            "--y",
+            "fill_top_m",
+            "--metric",
+            "kinetic_energy_j",
+        ],
+        dir,
+    );
+    let files: Vec<&str> = printed.lines().collect();
+    let stem = "c/plots/phase-kinetic_energy_j-rotation_rpm-fill_top_m";
+    assert_eq!(files, [format!("{stem}.png"), format!("{stem}.svg")]);
+
+    // The PNG: the stated size, and a picture (many colours), not a blank page.
+    let decoder = png::Decoder::new(std::fs::File::open(dir.join(files[0])).unwrap());
+    let mut reader = decoder.read_info().expect("a PNG");
+    let mut pixels = vec![0; reader.output_buffer_size()];
+    let info = reader.next_frame(&mut pixels).expect("its pixels");
+    assert_eq!((info.width, info.height), (1200, 900));
+    let stride = info.line_size / info.width as usize;
+    let mut colours = std::collections::HashSet::new();
+    for px in pixels[..info.buffer_size()].chunks(stride) {
+        colours.insert(px.to_vec());
+    }
+    assert!(colours.len() > 50, "{} colours", colours.len());
+
+    // The SVG: axis captions with units, the log-spaced axis said so, the parameter values, the metric's unit.
+    let svg = std::fs::read_to_string(dir.join(files[1])).unwrap();
+    // (plotters writes each text element's content on a line of its own.)
+    for text in [
+        "rotation_rpm [rpm] (log scale)",
+        "fill_top_m [m]",
+        "kinetic_energy_j [J]",
+        "10",
+        "20",
+        "40",
+        "-0.006",
+        "0",
+    ] {
+        assert!(svg.lines().any(|l| l.trim() == text), "the SVG lacks the text `{text}`");
+    }
+
+    // --out with an extension writes that format only; a `where` filter narrows the jobs.
+    let printed = run_ok(
+        &[
+            "plot",
+            "c",
+            "phase",
+            "--x",
+            "rotation_rpm",
+            "--y",
+            "fill_top_m",
+            "--metric",
+            "coordination_number",
+            "--out",
+            "mine.svg",
+        ],
+        dir,
+    );
+    assert_eq!(printed.trim(), "mine.svg");
+    assert!(dir.join("mine.svg").is_file() && !dir.join("mine.png").exists());
+
+    // Bad requests: exit 2, a message naming what is wrong, nothing written.
+    let before = std::fs::read_dir(dir.join("c/plots")).unwrap().count();
+    fails_with_2(
+        &[
+            "plot",
+            "c",
+            "phase",
+            "--x",
+            "rotation_rpm",
+            "--y",
+            "fill_top_m",
+            "--metric",
+            "kinetic_energi_j",
+        ],
+        dir,
+        "kinetic_energi_j",
+    );
+    fails_with_2(
+        &[
+            "plot",
+            "c",
+            "phase",
+            "--x",
+            "rotation_rmp",
+            "--y",
+            "fill_top_m",
+            "--metric",
+            "kinetic_energy_j",
+        ],
+        dir,
+        "no swept parameter `rotation_rmp`",
+    );
+    std::fs::write(dir.join("blocker"), "a file").unwrap();
+    fails_with_2(
+        &[
+            "plot",
+            "c",
+            "phase",
+            "--x",
+            "rotation_rpm",
+            "--y",
+            "fill_top_m",
+            "--metric",
+            "kinetic_energy_j",
+            "--out",
+            "blocker/diagram",
+        ],
+        dir,
+        "cannot write blocker/diagram.png",
+    );
+    assert_eq!(std::fs::read_dir(dir.join("c/plots")).unwrap().count(), before);
+
+    // A campaign with no finished job: its jobs 100 s long, the dispatcher interrupted (Ctrl-C) once they run.
+    let unfinished = CAMPAIGN
+        .replace("name: plot-mini", "name: plot-none")
+        .replace("end_time_s: 0.01", "end_time_s: 100.0");
+    std::fs::write(dir.join("none.yaml"), unfinished).unwrap();
+    let mut dispatcher = std::process::Command::new(env!("CARGO_BIN_EXE_granflow"))
+        .args(["run", "none.yaml", "--out", "none", "--quiet"])
+        .current_dir(dir)
+        .stdout(std::process::Stdio::null())
+        .stderr(std::process::Stdio::null())
+        .spawn()
+        .expect("the dispatcher starts");
+    let started = std::time::Instant::now();
+    while !dir.join("none/jobs").is_dir() || std::fs::read_dir(dir.join("none/jobs")).unwrap().count() == 0 {
+        assert!(started.elapsed().as_secs() < 120, "the campaign did not start");
+        std::thread::sleep(std::time::Duration::from_millis(100));
+    }
+    std::thread::sleep(std::time::Duration::from_millis(1500));
+    let interrupt = std::process::Command::new("kill")
+        .args(["-INT", &dispatcher.id().to_string()])
+        .status()
+        .expect("kill runs");
+    assert!(interrupt.success());
+    dispatcher.wait().expect("the dispatcher stops");
+    fails_with_2(
+        &[
+            "plot",
+            "none",
+            "phase",
+            "--x",
+            "rotation_rpm",
+            "--y",
+            "fill_top_m",
+            "--metric",
+            "kinetic_energy_j",
+        ],
+        dir,
+        "no job has finished yet",
+    );
+    assert!(!dir.join("none/plots").exists());
+}
