@@ -585,3 +585,41 @@ fn a_bead_attracted_to_a_sidewall_rolls_down_it_held_by_two_sevenths_of_its_weig
         }
     }
 }
+
+/// A bridge too small to count does not form (`engine::liquid::SMALLEST_BRIDGE`, 1e-6 R³): Mikami's fit read at
+/// vanishing volumes pulls without bound, so films of 5e-6 R³ (caps of 6.7e-7 R³ together) stay films when two
+/// beads touch, while films of 2e-5 R³ (caps of 2.7e-6 R³) bridge them; a bead with 1e-6 R³ on a floor (half of it,
+/// below the floor, would go to the wall) stays unbridged, one with 4e-6 R³ bridges.
+#[test]
+fn a_bridge_below_the_smallest_volume_does_not_form() {
+    for (content, forms) in [(5.0e-6, false), (2.0e-5, true)] {
+        let mut sim = two_beads(&pair(
+            "{ liquid_bridge: { surface_tension_n_per_m: 0.072, viscosity_pa_s: 0.001 } }",
+            5.0e-6,
+            &format!(", liquid_content: {content}"),
+        ));
+        sim.particles.velocity_m_per_s[0].x = 0.005;
+        sim.particles.velocity_m_per_s[1].x = -0.005;
+        sim.run_steps(2_000).expect("stable");
+        let s = sim.snapshot();
+        assert_eq!(
+            sim.cohesion_events.bridges_formed,
+            u64::from(forms),
+            "content {content}"
+        );
+        assert_eq!(s.contacts.cohesion().pairs.len(), usize::from(forms));
+        if !forms {
+            assert_eq!(s.particles.liquid_m3[0], content * 1e-9, "the film is untouched");
+        }
+    }
+    for (content, forms) in [(1.0e-6, false), (4.0e-6, true)] {
+        let yaml = bead_on_floor(true, 0.0).replace("liquid_content: 0.02", &format!("liquid_content: {content}"));
+        let mut sim = simulation(&built(&yaml), 1);
+        sim.run_steps(50_000).expect("stable");
+        assert_eq!(
+            sim.snapshot().contacts.cohesion().walls.len(),
+            usize::from(forms),
+            "wall, content {content}"
+        );
+    }
+}

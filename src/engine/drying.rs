@@ -39,7 +39,7 @@
 use super::contacts::AlignedHistory;
 use super::gas::coupled::{GasCoupling, GasScalarId};
 use super::gas::{GasScalarSpec, ScalarExchange};
-use super::liquid::total_liquid_m3;
+use super::liquid::{SMALLEST_BRIDGE, total_liquid_m3};
 use super::models::evaporation::{
     GAS_CONSTANT_J_PER_MOL_K, NORMAL_ATMOSPHERE_PA, hertz_knudsen_conductance_kg_per_s_pa, saturation_pressure_pa,
     saturation_pressure_slope_pa_per_k, vapour_diffusivity_m2_per_s,
@@ -52,15 +52,6 @@ pub const VAPOUR_FIELD: &str = "vapour_mass_fraction";
 
 /// Relative residual the vapour's linear solves reach: the ledger closes to about this (times the steps).
 pub const VAPOUR_SOLVE_TOLERANCE: f64 = 1e-14;
-
-/// A bridge that evaporation leaves below this volume over the smaller particle's R³ breaks, its remnant going back
-/// to its particles' films; a particle that would keep less than this over its R³ evaporates all it holds, and a
-/// film left below it evaporates at the end of the step into the particle's cell (bridges of 1e-120 m³, formed
-/// from films that had shrunk step after step, pulled E6's beads into quarter-radius overlaps). CHOICE: the smallest volume the bridge tables hold (`models::bridge_conduction`), far
-/// below the smallest Mikami fitted; his fit extrapolated to vanishing volumes gives a force that grows without
-/// bound as ln V̂ → −∞ (eqs 2.16–2.17), so a bridge dried geometrically towards zero would hold its pair ever
-/// tighter (a drum's bed overlapped by a quarter radius within 0.6 s of heating before this floor).
-pub const SMALLEST_BRIDGE: f64 = 1e-6;
 
 /// Solves of one drying step before it gives up (the capped set grows by at least one particle per solve, and in
 /// practice settles within a few).

@@ -3,7 +3,9 @@
 //! breaking bridge (and, later, evaporation).
 //!
 //! - A bridge forms when two particles touch and takes the liquid on each one's cap facing the other (seed 000
-//!   eqs 6.1–6.4); a bridge to a wall (the wall a sphere of infinite radius) takes half the particle's liquid.
+//!   eqs 6.1–6.4); a bridge to a wall (the wall a sphere of infinite radius) takes half the particle's liquid. A
+//!   bridge that would hold less than [`SMALLEST_BRIDGE`] of the smaller particle's R³ does not form: the liquid
+//!   stays on the films.
 //! - It keeps its volume until the gap passes the rupture gap, when the volume goes back to the two particles in the
 //!   shares of the parabolic bridge (6.33–6.44); a wall keeps nothing (CHOICE: the film a wall would keep is not
 //!   tracked), so all of it returns to the particle.
@@ -23,6 +25,16 @@ use super::models::cohesion_law::CohesionModel;
 use super::neighbor::NeighborList;
 use super::particles::Particles;
 use super::spray::spray_surface;
+
+/// The smallest bridge, over the smaller particle's R³: a bridge that would form with less does not form (its
+/// particles keep their films), and one that evaporation leaves below it breaks (`engine::drying`). CHOICE: the
+/// smallest volume the bridge tables hold (`models::bridge_conduction`), far below the smallest Mikami fitted; his
+/// fit extrapolated to vanishing volumes gives a force that grows without bound as ln V̂ → −∞ (eqs 2.16–2.17:
+/// F̂ ≈ 2,600 at V̂ = 1e-170 against 2.4 at 1e-3), while a real bridge's force tends to a finite limit. Without
+/// the floor, a drying drum's films shrunk step after step formed bridges of 1e-120 m³ (and, once a film under it
+/// evaporated at each gas step, bridges of 1e-173 m³ from films split between gas steps by formation after
+/// formation), which pulled E6's beads into quarter-radius overlaps.
+pub const SMALLEST_BRIDGE: f64 = 1e-6;
 
 /// Per pair and wall slot of the neighbour list: the constants of its bridge for the volume they were computed for,
 /// and which slots are near enough to a formation or rupture to be examined every step (workspace: rebuilt from the
@@ -257,7 +269,7 @@ impl Exchange<'_> {
         }
         if volume == 0.0 && dist2.sqrt() - reach < 0.0 {
             let (from_i, from_j) = bridge_volume_on_contact_m3(p.liquid_m3[i], ri, p.liquid_m3[j], rj);
-            if from_i + from_j > 0.0 {
+            if from_i + from_j >= SMALLEST_BRIDGE * ri.min(rj).powi(3) {
                 p.liquid_m3[i] -= from_i;
                 p.liquid_m3[j] -= from_j;
                 volume = from_i + from_j;
@@ -310,7 +322,7 @@ impl Exchange<'_> {
         if gap >= cohesion.wall_range_m && volume == 0.0 {
             return if moving { 0.0 } else { gap };
         }
-        if volume == 0.0 && gap < 0.0 && p.liquid_m3[i] > 0.0 {
+        if volume == 0.0 && gap < 0.0 && 0.5 * p.liquid_m3[i] >= SMALLEST_BRIDGE * ri.powi(3) {
             // Eq 6.1 with R_j → ∞: the cap facing a plane is half the particle.
             let taken = 0.5 * p.liquid_m3[i];
             p.liquid_m3[i] -= taken;
