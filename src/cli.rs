@@ -107,6 +107,15 @@ pub enum Command {
         #[command(subcommand)]
         picture: PlotPicture,
     },
+    /// Snapshots for ParaView (VTK XML, indexed by `particles.pvd` and `gas.pvd`) of every checkpoint a run or job
+    /// directory holds; prints the files written. A run with `output.snapshots_every_s` writes them as it goes.
+    Snapshots {
+        /// The run's (`granflow simulate --out`) or a campaign job's directory.
+        dir: PathBuf,
+        /// Write them here instead of <dir>/snapshots.
+        #[arg(long)]
+        out: Option<PathBuf>,
+    },
     /// Parameters and metrics, one row per job.
     Export {
         /// The campaign directory.
@@ -413,7 +422,7 @@ pub fn run(cli: Cli) -> Result<i32> {
                 } => crate::plot::phase(&dir, &x, &y, &metric, &filters, out.as_deref())?,
             };
             let list: Vec<String> = written.iter().map(|p| p.display().to_string()).collect();
-            emit(&list.join("\n"))?;
+            emit(&format!("{}\n", list.join("\n")))?;
             Ok(0)
         }
         Command::Status { dir } => {
@@ -449,6 +458,12 @@ pub fn run(cli: Cli) -> Result<i32> {
         }
         Command::Export { dir, format } => {
             emit(&inspect::export(&dir, format)?)?;
+            Ok(0)
+        }
+        Command::Snapshots { dir, out } => {
+            let written = crate::snapshot::from_checkpoints(&dir, out.as_deref())?;
+            let list: Vec<String> = written.iter().map(|p| p.display().to_string()).collect();
+            emit(&format!("{}\n", list.join("\n")))?;
             Ok(0)
         }
         Command::Reduce { dir } => {

@@ -27,7 +27,9 @@ pub mod provenance;
 pub mod report;
 pub mod scenario;
 pub mod simulate;
+pub mod snapshot;
 pub mod store;
+pub mod units;
 pub mod util;
 pub mod worker;
 

@@ -624,6 +624,16 @@ pub fn run_in_dir(built: &BuiltScenario, out: &Path, ctl: RunControl) -> Result<
         );
     }
     let every = |n: u64, k: u64| (n / k + 1) * k;
+    // Snapshots for ParaView: at the start of a new run, every `snapshots_every_s`, and at the end.
+    let snapshot_dir = out.join(crate::snapshot::SNAPSHOT_DIR);
+    let snapshot_every = built
+        .spec
+        .output
+        .snapshots_every_s
+        .map(|every_s| crate::snapshot::every_steps(every_s, sim.dt_s));
+    if snapshot_every.is_some() && resumed_from_step.is_none() {
+        crate::snapshot::write_snapshot(&sim, &snapshot_dir)?;
+    }
     let mut checkpoint_time_s = 0.0;
     let mut checkpoints_written = 0u64;
     let mut write_checkpoint = |sim: &Simulation, observer: &mut dyn RunObserver| -> Result<()> {
@@ -644,8 +654,12 @@ pub fn run_in_dir(built: &BuiltScenario, out: &Path, ctl: RunControl) -> Result<
         let next = every(sim.step, built.spec.output.series_every_steps)
             .min(every(sim.step, built.spec.output.checkpoint_every_steps))
             .min(every(sim.step, CHUNK_STEPS))
+            .min(snapshot_every.map_or(u64::MAX, |k| every(sim.step, k)))
             .min(stop_at);
         sim.run_steps(next - sim.step)?;
+        if snapshot_every.is_some_and(|k| sim.step % k == 0 || sim.step == total_steps) {
+            crate::snapshot::write_snapshot(&sim, &snapshot_dir)?;
+        }
         if sim.step % built.spec.output.series_every_steps == 0 {
             let row = format!("{}{}", series_row(&mut sim, built), observer.extra_row(&sim));
             writeln!(series_file, "{row}").map_err(|e| Error::io("write", &series_path, e))?;

@@ -59,6 +59,23 @@ const CASES: &[(&str, &str, &str, &[&str])] = &[
         &["bad.yaml", "neighbor.sort_every_steps", "at least 1"],
     ),
     (
+        "snapshots every zero seconds",
+        "time: { dt_s: 1.0e-5, end_time_s: 0.001 }",
+        "time: { dt_s: 1.0e-5, end_time_s: 0.001 }\noutput: { snapshots_every_s: 0.0 }",
+        &["bad.yaml", "output.snapshots_every_s", "expected a finite value > 0"],
+    ),
+    (
+        "more snapshots than a disk should take",
+        "time: { dt_s: 1.0e-5, end_time_s: 0.001 }",
+        "time: { dt_s: 1.0e-5, end_time_s: 0.001 }\noutput: { snapshots_every_s: 1.0e-9 }",
+        &[
+            "bad.yaml",
+            "output.snapshots_every_s",
+            "1000000 snapshots",
+            "at most 10000",
+        ],
+    ),
+    (
         "a sort period that is not a whole number",
         "time: { dt_s: 1.0e-5, end_time_s: 0.001 }",
         "time: { dt_s: 1.0e-5, end_time_s: 0.001 }\nneighbor: { sort_every_steps: 2.5 }",

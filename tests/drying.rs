@@ -6,7 +6,7 @@ mod common;
 
 use std::f64::consts::PI;
 
-use common::{KILN, built, whole_and_resumed, with_gas, with_gas_on};
+use common::{built, wet_drying_kiln, whole_and_resumed, with_gas, with_gas_on};
 use granflow::engine::Simulation;
 use granflow::engine::models::evaporation::{
     WATER_MOLAR_MASS_KG_PER_MOL, hertz_knudsen_conductance_kg_per_s_pa, saturation_pressure_pa, vapour_pressure_pa,
@@ -283,17 +283,7 @@ fn a_drying_bridge_breaks_and_the_pair_stays_at_rest() {
 /// that heat is percent of the start's; and the ledger is the same bits on one thread and on two.
 #[test]
 fn a_heated_drying_drum_closes_its_energy_ledger_on_any_thread_count() {
-    let yaml = KILN
-        .replace(
-            "youngs_modulus_pa: 1.0e7 }",
-            "youngs_modulus_pa: 1.0e7, contact_angle_deg: 0.0, liquid_content: 0.02 }",
-        )
-        .replace(
-            "walls:\n  - drum",
-            "cohesion: { liquid_bridge: { surface_tension_n_per_m: 0.072, viscosity_pa_s: 0.001, walls: true } }\nwalls:\n  - drum",
-        )
-        .replace("from_s: 0.02 } }", "from_s: 0.0 } }\n  gas: { lens_conduction: {} }")
-        + "drying: { evaporation_coefficient: 1.0 }\n";
+    let yaml = wet_drying_kiln();
     let b = built(&yaml);
     let mut one = with_gas_on(&b, 1);
     let mut two = with_gas_on(&b, 2);

@@ -2,14 +2,12 @@
 //! the embedded DejaVu Sans, so nothing beyond the binary is needed).
 //!
 //! - `phase_diagram.rs`: one metric over two swept parameters as a coloured map.
-//! - `units.rs`: a parameter's unit from its SI suffix, for the captions.
 //!
 //! Every picture is written to a temporary file beside its destination and renamed into place, so a failure leaves
 //! nothing half-written; bad requests (an unknown parameter or metric, a campaign with no finished job that has the
 //! metric, an output path that cannot be written) fail before anything is drawn, with exit code 2.
 
 pub mod phase_diagram;
-pub mod units;
 
 use std::io::Write;
 use std::path::{Path, PathBuf};

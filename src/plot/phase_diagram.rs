@@ -13,8 +13,8 @@ use plotters::coord::ranged1d::SegmentValue;
 use plotters::prelude::*;
 use plotters::style::colors::colormaps::ViridisRGB;
 
-use super::units::{caption, parameter_unit};
 use crate::store::{ParamValue, Pivot};
+use crate::units::{caption, parameter_unit};
 
 /// The picture's size in pixels (PNG) or user units (SVG).
 pub const SIZE: (u32, u32) = (1200, 900);

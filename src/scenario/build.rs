@@ -22,6 +22,10 @@ use crate::engine::simulation::SimConfig;
 use crate::engine::state::RngState;
 
 /// A validated scenario, ready to run.
+/// Most snapshots a run writes (`output.snapshots_every_s`): each holds every particle, so more would fill a disk
+/// before it said anything the eye can follow.
+pub const MAX_SNAPSHOTS: u64 = 10_000;
+
 pub struct BuiltScenario {
     pub spec: ScenarioSpec,
     pub config: Arc<SimConfig>,
@@ -187,6 +191,21 @@ pub fn build(spec: ScenarioSpec, path: &Path) -> Result<BuiltScenario, ConfigErr
     }
     if spec.output.keep_checkpoints == 0 {
         return Err(c.fail("output.keep_checkpoints", "expected at least 1"));
+    }
+    if let Some(every_s) = spec.output.snapshots_every_s {
+        c.positive("output.snapshots_every_s", every_s)?;
+        let count = spec.time.end_time_s / every_s;
+        if count > MAX_SNAPSHOTS as f64 {
+            return Err(c.fail(
+                "output.snapshots_every_s",
+                format!(
+                    "{every_s} s over an end time of {} s makes {count:.0} snapshots; at most {MAX_SNAPSHOTS} are \
+                     written (choose at least {:e} s)",
+                    spec.time.end_time_s,
+                    spec.time.end_time_s / MAX_SNAPSHOTS as f64
+                ),
+            ));
+        }
     }
 
     let pair_table = PairTable::new(&species, &spec.contact);

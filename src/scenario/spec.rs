@@ -550,6 +550,12 @@ pub struct OutputSpec {
     /// `wall_contact_time_fraction`). Adds the checkpoint's `particles/channels` datasets. Default: false.
     #[serde(default, skip_serializing_if = "std::ops::Not::not")]
     pub contact_statistics: bool,
+    /// Write particle (and gas) snapshots for ParaView every this many seconds of simulated time, and at the run's
+    /// start and end, into `snapshots/` of the run's directory (VTK XML: `particles.pvd`, `gas.pvd`; `snapshot`
+    /// module). At most 10,000 over the run. Default: none (`granflow snapshots <dir>` makes them from the
+    /// checkpoints afterwards).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub snapshots_every_s: Option<f64>,
 }
 
 fn default_checkpoint_every() -> u64 {
@@ -570,6 +576,7 @@ impl Default for OutputSpec {
             series_every_steps: default_series_every(),
             net_forces: false,
             contact_statistics: false,
+            snapshots_every_s: None,
         }
     }
 }

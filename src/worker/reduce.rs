@@ -129,18 +129,10 @@ impl Series {
 
     /// The unit of a series column (from its name's suffix).
     pub fn unit_of(name: &str) -> &'static str {
-        if name.ends_with("_j") {
-            "J"
-        } else if name.ends_with("_m") {
-            "m"
-        } else if name.ends_with("_s") {
-            "s"
-        } else if name.ends_with("_pa") {
-            "Pa"
-        } else if name == "step" || name.ends_with("contacts") {
+        if name == "step" || name.ends_with("contacts") || name == "core_particles" {
             "count"
         } else {
-            "1"
+            crate::units::parameter_unit(name).unwrap_or("1")
         }
     }
 }

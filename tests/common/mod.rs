@@ -164,3 +164,18 @@ heat:
   initial_temperature_k: 300.0
   walls: { drum: { temperature_k: 400.0, from_s: 0.02 } }
 "#;
+
+/// [`KILN`] with wet beads (V/R³ = 0.02, bridges to each other and to the wall), the wall hot from the start, gas
+/// lenses and drying: every particle and gas field a run can carry.
+pub fn wet_drying_kiln() -> String {
+    KILN.replace(
+        "youngs_modulus_pa: 1.0e7 }",
+        "youngs_modulus_pa: 1.0e7, contact_angle_deg: 0.0, liquid_content: 0.02 }",
+    )
+    .replace(
+        "walls:\n  - drum",
+        "cohesion: { liquid_bridge: { surface_tension_n_per_m: 0.072, viscosity_pa_s: 0.001, walls: true } }\nwalls:\n  - drum",
+    )
+    .replace("from_s: 0.02 } }", "from_s: 0.0 } }\n  gas: { lens_conduction: {} }")
+        + "drying: { evaporation_coefficient: 1.0 }\n"
+}

@@ -1,5 +1,6 @@
-//! A swept parameter's unit, read from the SI suffix its name carries by the project's naming rule
-//! (`radius_m`, `wall_temperature_k`, `superficial_velocity_m_per_s`): the axis captions of the pictures.
+//! A quantity's unit, read from the SI suffix its name carries by the project's naming rule (`radius_m`,
+//! `wall_temperature_k`, `superficial_velocity_m_per_s`): the pictures' axis captions and the `units` attribute of
+//! `series.h5`'s columns.
 
 /// Suffixes and their units, longest first so that `_m_per_s` wins over `_s`.
 const SUFFIXES: &[(&str, &str)] = &[
@@ -11,6 +12,7 @@ const SUFFIXES: &[(&str, &str)] = &[
     ("_w_per_m2_k", "W/(m² K)"),
     ("_j_per_kg_k", "J/(kg K)"),
     ("_j_per_kg", "J/kg"),
+    ("_kg_per_s", "kg/s"),
     ("_per_s", "1/s"),
     ("_pa_s", "Pa s"),
     ("_rpm", "rpm"),
