@@ -202,6 +202,26 @@ pub enum PlotPicture {
         #[arg(long)]
         out: Option<PathBuf>,
     },
+    /// A metric against one swept parameter, one line per value of a second (`--lines`); each point the mean over
+    /// the jobs at it (replicates, other parameters) with their standard deviation as an error bar.
+    Curve {
+        /// The parameter along x (a swept path or its unique last key).
+        #[arg(long)]
+        x: String,
+        /// One line per value of this parameter (default: one line).
+        #[arg(long)]
+        lines: Option<String>,
+        /// The metric along y.
+        #[arg(long)]
+        metric: String,
+        /// Only jobs whose parameter has this value (repeatable), as `query --pivot --where`.
+        #[arg(long = "where", value_name = "PARAM=VALUE")]
+        filters: Vec<String>,
+        /// Output file: `.png` or `.svg` for that format only, otherwise a stem given both extensions (default
+        /// <dir>/plots/curve-<metric>-<x>[-by-<lines>]).
+        #[arg(long)]
+        out: Option<PathBuf>,
+    },
 }
 
 #[derive(Debug, clap::Args)]
@@ -420,6 +440,13 @@ pub fn run(cli: Cli) -> Result<i32> {
                     filters,
                     out,
                 } => crate::plot::phase(&dir, &x, &y, &metric, &filters, out.as_deref())?,
+                PlotPicture::Curve {
+                    x,
+                    lines,
+                    metric,
+                    filters,
+                    out,
+                } => crate::plot::curve(&dir, &x, lines.as_deref(), &metric, &filters, out.as_deref())?,
             };
             let list: Vec<String> = written.iter().map(|p| p.display().to_string()).collect();
             emit(&format!("{}\n", list.join("\n")))?;

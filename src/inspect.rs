@@ -184,8 +184,20 @@ pub(crate) fn pivot_of(
     metric: &str,
     filters: &[String],
 ) -> Result<(store::Pivot, Campaign), Error> {
+    layout_of(dir, x, Some(y), metric, filters)
+}
+
+/// [`pivot_of`], or without `y` the curve of `metric` over `x` alone (`Store::curve_where`).
+pub(crate) fn layout_of(
+    dir: &Path,
+    x: &str,
+    y: Option<&str>,
+    metric: &str,
+    filters: &[String],
+) -> Result<(store::Pivot, Campaign), Error> {
     let (store, id, campaign) = open(dir)?;
-    let (x, y) = (resolve_param(&store, x)?, resolve_param(&store, y)?);
+    let x = resolve_param(&store, x)?;
+    let y = y.map(|y| resolve_param(&store, y)).transpose()?;
     let mut wanted = Vec::new();
     for filter in filters {
         let Some((name, value)) = filter.split_once('=') else {
@@ -199,7 +211,11 @@ pub(crate) fn pivot_of(
         };
         wanted.push((resolve_param(&store, name.trim())?, value));
     }
-    let p = store.pivot_where(id, &x, &y, metric, &wanted).map_err(|e| match e {
+    let laid_out = match &y {
+        Some(y) => store.pivot_where(id, &x, y, metric, &wanted),
+        None => store.curve_where(id, &x, metric, &wanted),
+    };
+    let p = laid_out.map_err(|e| match e {
         store::StoreError::UnknownParameter { .. }
         | store::StoreError::UnknownMetric { .. }
         | store::StoreError::InvalidQuery { .. } => Error::Usage(e.to_string()),

@@ -57,6 +57,26 @@ fn fails_with_2(args: &[&str], cwd: &Path, message: &str) {
     );
 }
 
+/// The number of distinct colours of the 1200 × 900 PNG at `path` (fails on another size).
+fn png_colours(path: &Path) -> usize {
+    let decoder = png::Decoder::new(std::fs::File::open(path).unwrap());
+    let mut reader = decoder.read_info().expect("a PNG");
+    let mut pixels = vec![0; reader.output_buffer_size()];
+    let info = reader.next_frame(&mut pixels).expect("its pixels");
+    assert_eq!((info.width, info.height), (1200, 900), "{}", path.display());
+    let stride = info.line_size / info.width as usize;
+    let mut colours = std::collections::HashSet::new();
+    for px in pixels[..info.buffer_size()].chunks(stride) {
+        colours.insert(px.to_vec());
+    }
+    colours.len()
+}
+
+/// Whether the SVG text at `svg` holds `text` as a text element's content (plotters writes each on its own line).
+fn svg_has(svg: &str, text: &str) -> bool {
+    svg.lines().any(|l| l.trim() == text)
+}
+
 #[test]
 fn a_phase_diagram_is_drawn_as_png_and_svg_and_bad_requests_exit_2() {
     let tmp = tempfile::tempdir().expect("temp dir");
@@ -83,17 +103,7 @@ fn a_phase_diagram_is_drawn_as_png_and_svg_and_bad_requests_exit_2() {
     assert_eq!(files, [format!("{stem}.png"), format!("{stem}.svg")]);
 
     // The PNG: the stated size, and a picture (many colours), not a blank page.
-    let decoder = png::Decoder::new(std::fs::File::open(dir.join(files[0])).unwrap());
-    let mut reader = decoder.read_info().expect("a PNG");
-    let mut pixels = vec![0; reader.output_buffer_size()];
-    let info = reader.next_frame(&mut pixels).expect("its pixels");
-    assert_eq!((info.width, info.height), (1200, 900));
-    let stride = info.line_size / info.width as usize;
-    let mut colours = std::collections::HashSet::new();
-    for px in pixels[..info.buffer_size()].chunks(stride) {
-        colours.insert(px.to_vec());
-    }
-    assert!(colours.len() > 50, "{} colours", colours.len());
+    assert!(png_colours(&dir.join(files[0])) > 50);
 
     // The SVG: axis captions with units, the log-spaced axis said so, the parameter values, the metric's unit.
     let svg = std::fs::read_to_string(dir.join(files[1])).unwrap();
@@ -108,8 +118,82 @@ fn a_phase_diagram_is_drawn_as_png_and_svg_and_bad_requests_exit_2() {
         "-0.006",
         "0",
     ] {
-        assert!(svg.lines().any(|l| l.trim() == text), "the SVG lacks the text `{text}`");
+        assert!(svg_has(&svg, text), "the SVG lacks the text `{text}`");
     }
+
+    // A curve: the metric against the speed, a line per fill level; then one line averaging both fills, with the
+    // two jobs' standard deviation as error bars.
+    let printed = run_ok(
+        &[
+            "plot",
+            "c",
+            "curve",
+            "--x",
+            "rotation_rpm",
+            "--lines",
+            "fill_top_m",
+            "--metric",
+            "kinetic_energy_j",
+        ],
+        dir,
+    );
+    let stem = "c/plots/curve-kinetic_energy_j-rotation_rpm-by-fill_top_m";
+    assert_eq!(
+        printed.lines().collect::<Vec<_>>(),
+        [format!("{stem}.png"), format!("{stem}.svg")]
+    );
+    assert!(png_colours(&dir.join(format!("{stem}.png"))) > 10);
+    let svg = std::fs::read_to_string(dir.join(format!("{stem}.svg"))).unwrap();
+    for text in [
+        "rotation_rpm [rpm] (log scale)",
+        "kinetic_energy_j [J]",
+        "fill_top_m [m] = -0.006",
+        "fill_top_m [m] = 0",
+        "10",
+        "20",
+        "40",
+    ] {
+        assert!(svg_has(&svg, text), "the curve's SVG lacks the text `{text}`");
+    }
+    run_ok(
+        &[
+            "plot",
+            "c",
+            "curve",
+            "--x",
+            "rotation_rpm",
+            "--metric",
+            "kinetic_energy_j",
+            "--out",
+            "one.svg",
+        ],
+        dir,
+    );
+    let one = std::fs::read_to_string(dir.join("one.svg")).unwrap();
+    assert!(svg_has(&one, "kinetic_energy_j"), "the legend names the metric");
+    // Three points, each with an error bar: more line elements than the one-line curve without bars would have.
+    let lines_drawn = |svg: &str| svg.matches("<line").count() + svg.matches("<polyline").count();
+    assert!(
+        lines_drawn(&one) >= lines_drawn(&svg) / 2 + 3,
+        "error bars drawn: {} vs {}",
+        lines_drawn(&one),
+        lines_drawn(&svg)
+    );
+    fails_with_2(
+        &[
+            "plot",
+            "c",
+            "curve",
+            "--x",
+            "rotation_rpm",
+            "--lines",
+            "rotation_rpm",
+            "--metric",
+            "kinetic_energy_j",
+        ],
+        dir,
+        "two different parameters",
+    );
 
     // --out with an extension writes that format only; a `where` filter narrows the jobs.
     let printed = run_ok(

@@ -2,11 +2,13 @@
 //! the embedded DejaVu Sans, so nothing beyond the binary is needed).
 //!
 //! - `phase_diagram.rs`: one metric over two swept parameters as a coloured map.
+//! - `curve.rs`: one metric against one parameter, a line per value of a second, replicates' error bars.
 //!
 //! Every picture is written to a temporary file beside its destination and renamed into place, so a failure leaves
 //! nothing half-written; bad requests (an unknown parameter or metric, a campaign with no finished job that has the
 //! metric, an output path that cannot be written) fail before anything is drawn, with exit code 2.
 
+pub mod curve;
 pub mod phase_diagram;
 
 use std::io::Write;
@@ -151,6 +153,65 @@ fn write_pictures(
     Ok(written)
 }
 
+/// The "no finished job has a value" usage error (exit 2) of a layout with no value in any cell.
+fn require_values(
+    pivot: &crate::store::Pivot,
+    campaign: &crate::campaign::Campaign,
+    metric: &str,
+    filters: &[String],
+    dir: &Path,
+) -> Result<(), Error> {
+    if pivot.cells.iter().flatten().flatten().any(|c| c.mean.is_finite()) {
+        return Ok(());
+    }
+    Err(Error::Usage(format!(
+        "campaign {}: no finished job has a value of `{metric}`{} (see `granflow status {}`)",
+        campaign.spec.name,
+        if filters.is_empty() {
+            String::new()
+        } else {
+            format!(" where {}", filters.join(", "))
+        },
+        dir.display()
+    )))
+}
+
+/// The picture's title: the metric, the campaign, the filters.
+fn title(metric: &str, campaign: &crate::campaign::Campaign, filters: &[String]) -> String {
+    let mut title = format!("{metric} — {}", campaign.spec.name);
+    if !filters.is_empty() {
+        title.push_str(&format!(" ({})", filters.join(", ")));
+    }
+    title
+}
+
+/// `granflow plot <dir> curve`: `metric` against `x`, one line per value of `lines` (one line without), of the
+/// done jobs matching `filters`, error bars from the jobs each point averages. Returns the files written.
+pub fn curve(
+    dir: &Path,
+    x: &str,
+    lines: Option<&str>,
+    metric: &str,
+    filters: &[String],
+    out: Option<&Path>,
+) -> Result<Vec<PathBuf>, Error> {
+    let (pivot, campaign) = crate::inspect::layout_of(dir, x, lines, metric, filters)?;
+    require_values(&pivot, &campaign, metric, filters, dir)?;
+    let mut stem = format!("curve-{}-{}", file_part(metric), file_part(&pivot.x_param));
+    if !pivot.y_param.is_empty() {
+        stem.push_str(&format!("-by-{}", file_part(&pivot.y_param)));
+    }
+    let outputs = outputs(dir, out, &stem);
+    check_writable(&outputs)?;
+    let title = title(&pivot.metric, &campaign, filters);
+    write_pictures(
+        &outputs,
+        curve::SIZE,
+        |root| curve::draw(root, &pivot, &title),
+        |root| curve::draw(root, &pivot, &title),
+    )
+}
+
 /// `granflow plot <dir> phase`: `metric` over `x` (columns) and `y` (rows) of the done jobs matching `filters`.
 /// Returns the files written.
 pub fn phase(
@@ -162,18 +223,7 @@ pub fn phase(
     out: Option<&Path>,
 ) -> Result<Vec<PathBuf>, Error> {
     let (pivot, campaign) = crate::inspect::pivot_of(dir, x, y, metric, filters)?;
-    if !pivot.cells.iter().flatten().flatten().any(|c| c.mean.is_finite()) {
-        return Err(Error::Usage(format!(
-            "campaign {}: no finished job has a value of `{metric}`{} (see `granflow status {}`)",
-            campaign.spec.name,
-            if filters.is_empty() {
-                String::new()
-            } else {
-                format!(" where {}", filters.join(", "))
-            },
-            dir.display()
-        )));
-    }
+    require_values(&pivot, &campaign, metric, filters, dir)?;
     let stem = format!(
         "phase-{}-{}-{}",
         file_part(metric),
@@ -182,10 +232,7 @@ pub fn phase(
     );
     let outputs = outputs(dir, out, &stem);
     check_writable(&outputs)?;
-    let mut title = format!("{} — {}", pivot.metric, campaign.spec.name);
-    if !filters.is_empty() {
-        title.push_str(&format!(" ({})", filters.join(", ")));
-    }
+    let title = title(&pivot.metric, &campaign, filters);
     write_pictures(
         &outputs,
         phase_diagram::SIZE,

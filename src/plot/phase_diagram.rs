@@ -55,7 +55,7 @@ pub fn significant(v: f64, digits: usize) -> String {
 }
 
 /// Whether the numbers of an axis are log-spaced (at least three, all positive, one ratio).
-fn is_geometric(values: &[ParamValue]) -> bool {
+pub(crate) fn is_geometric(values: &[ParamValue]) -> bool {
     let numbers: Vec<f64> = values
         .iter()
         .filter_map(|v| match v {
@@ -74,7 +74,7 @@ fn is_geometric(values: &[ParamValue]) -> bool {
 }
 
 /// The axis caption: the parameter's name with its unit, and "log scale" for a logspace sweep.
-fn axis_caption(name: &str, values: &[ParamValue]) -> String {
+pub(crate) fn axis_caption(name: &str, values: &[ParamValue]) -> String {
     let text = caption(name, parameter_unit(name));
     if is_geometric(values) {
         format!("{text} (log scale)")

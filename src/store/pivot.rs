@@ -23,6 +23,8 @@ pub struct PivotCell {
     pub mean: f64,
     /// Number of jobs averaged; more than 1 when parameters other than x and y vary.
     pub count: usize,
+    /// Sample standard deviation (n − 1) of the jobs averaged: replicates' scatter; `None` for a single job.
+    pub std: Option<f64>,
 }
 
 /// A metric over two parameters.
@@ -41,6 +43,19 @@ pub struct Pivot {
     pub cells: Vec<Vec<Option<PivotCell>>>,
     /// Only jobs with these parameter values were laid out (empty: all).
     pub filters: Vec<(String, ParamValue)>,
+}
+
+/// The cell of `values` (the jobs at one x and y, in the database's order): their mean (summed in that order) and
+/// sample standard deviation; `None` without any.
+fn cell_of(values: &[f64]) -> Option<PivotCell> {
+    let count = values.len();
+    if count == 0 {
+        return None;
+    }
+    let mean = values.iter().sum::<f64>() / count as f64;
+    let std =
+        (count > 1).then(|| (values.iter().map(|v| (v - mean) * (v - mean)).sum::<f64>() / (count - 1) as f64).sqrt());
+    Some(PivotCell { mean, count, std })
 }
 
 impl Store {
@@ -62,14 +77,40 @@ impl Store {
         metric: &str,
         filters: &[(String, ParamValue)],
     ) -> Result<Pivot, StoreError> {
+        self.layout(campaign_id, x_param, Some(y_param), metric, filters)
+    }
+
+    /// `metric` over `x_param` alone (a curve): [`Store::pivot_where`] with one row, whose parameter is `""` and
+    /// whose one value is the text `""`; each cell averages every matching job at that x.
+    pub fn curve_where(
+        &self,
+        campaign_id: i64,
+        x_param: &str,
+        metric: &str,
+        filters: &[(String, ParamValue)],
+    ) -> Result<Pivot, StoreError> {
+        self.layout(campaign_id, x_param, None, metric, filters)
+    }
+
+    fn layout(
+        &self,
+        campaign_id: i64,
+        x_param: &str,
+        y_param: Option<&str>,
+        metric: &str,
+        filters: &[(String, ParamValue)],
+    ) -> Result<Pivot, StoreError> {
         self.require_campaign(campaign_id)?;
-        if x_param == y_param {
+        if Some(x_param) == y_param {
             return Err(StoreError::InvalidQuery {
                 path: self.path.clone(),
                 reason: format!("a pivot needs two different parameters, got `{x_param}` for both axes"),
             });
         }
-        let action = format!("pivoting `{metric}` over `{x_param}` and `{y_param}` in campaign {campaign_id}");
+        let action = match y_param {
+            Some(y_param) => format!("pivoting `{metric}` over `{x_param}` and `{y_param}` in campaign {campaign_id}"),
+            None => format!("laying out `{metric}` over `{x_param}` in campaign {campaign_id}"),
+        };
 
         let parameters: Vec<String> = self
             .strings(
@@ -78,8 +119,8 @@ impl Store {
                 params![campaign_id],
             )
             .context(&self.path, &action)?;
-        for name in [x_param, y_param]
-            .into_iter()
+        for name in std::iter::once(x_param)
+            .chain(y_param)
             .chain(filters.iter().map(|(name, _)| name.as_str()))
         {
             if !parameters.iter().any(|known| known == name) {
@@ -123,7 +164,10 @@ impl Store {
         let unit = units.pop().expect("the metric exists, so it has at least one unit");
 
         let x_values = self.axis_values(campaign_id, x_param).context(&self.path, &action)?;
-        let y_values = self.axis_values(campaign_id, y_param).context(&self.path, &action)?;
+        let y_values = match y_param {
+            Some(y_param) => self.axis_values(campaign_id, y_param).context(&self.path, &action)?,
+            None => vec![ParamValue::Text(String::new())],
+        };
         let points = self
             .pivot_points(campaign_id, x_param, y_param, metric)
             .context(&self.path, &action)?;
@@ -141,7 +185,7 @@ impl Store {
                 Some(k) => k.intersection(&matching).cloned().collect(),
             });
         }
-        let mut sums = vec![vec![(0.0, 0usize); x_values.len()]; y_values.len()];
+        let mut values = vec![vec![Vec::<f64>::new(); x_values.len()]; y_values.len()];
         for (job, x, y, value) in points {
             if kept.as_ref().is_some_and(|k| !k.contains(&job)) {
                 continue;
@@ -150,26 +194,15 @@ impl Store {
             let column = x_values.binary_search_by(|probe| probe.axis_cmp(&x));
             let row = y_values.binary_search_by(|probe| probe.axis_cmp(&y));
             let (Ok(column), Ok(row)) = (column, row) else { continue };
-            let (sum, count) = &mut sums[row][column];
-            *sum += value;
-            *count += 1;
+            values[row][column].push(value);
         }
-        let cells = sums
+        let cells = values
             .into_iter()
-            .map(|row| {
-                row.into_iter()
-                    .map(|(sum, count)| {
-                        (count > 0).then(|| PivotCell {
-                            mean: sum / count as f64,
-                            count,
-                        })
-                    })
-                    .collect()
-            })
+            .map(|row| row.into_iter().map(|v| cell_of(&v)).collect())
             .collect();
         Ok(Pivot {
             x_param: x_param.to_string(),
-            y_param: y_param.to_string(),
+            y_param: y_param.unwrap_or_default().to_string(),
             metric: metric.to_string(),
             unit,
             x_values,
@@ -192,23 +225,30 @@ impl Store {
         rows.filter_map(Result::transpose).collect()
     }
 
-    /// (job id, x value, y value, metric value) of every done job of the campaign that has both parameters and a non-NULL
-    /// value of the metric.
+    /// (job id, x value, y value, metric value) of every done job of the campaign that has both parameters (x alone
+    /// without `y_param`, y then the text `""`) and a non-NULL value of the metric.
     fn pivot_points(
         &self,
         campaign_id: i64,
         x_param: &str,
-        y_param: &str,
+        y_param: Option<&str>,
         metric: &str,
     ) -> rusqlite::Result<Vec<(String, ParamValue, ParamValue, f64)>> {
-        let mut stmt = self.conn.prepare_cached(
+        let mut stmt = self.conn.prepare_cached(if y_param.is_some() {
             "SELECT px.value_real, px.value_text, py.value_real, py.value_text, m.value, j.job_id
              FROM jobs j
              JOIN params px ON px.job_id = j.job_id AND px.name = ?2
              JOIN params py ON py.job_id = j.job_id AND py.name = ?3
              JOIN metrics m ON m.job_id = j.job_id AND m.name = ?4
-             WHERE j.campaign_id = ?1 AND j.status = ?5 AND m.value IS NOT NULL",
-        )?;
+             WHERE j.campaign_id = ?1 AND j.status = ?5 AND m.value IS NOT NULL"
+        } else {
+            "SELECT px.value_real, px.value_text, NULL, ?3, m.value, j.job_id
+             FROM jobs j
+             JOIN params px ON px.job_id = j.job_id AND px.name = ?2
+             JOIN metrics m ON m.job_id = j.job_id AND m.name = ?4
+             WHERE j.campaign_id = ?1 AND j.status = ?5 AND m.value IS NOT NULL"
+        })?;
+        let y_param = y_param.unwrap_or_default();
         let rows = stmt.query_map(params![campaign_id, x_param, y_param, metric, JobStatus::Done], |row| {
             let x = ParamValue::from_columns(row.get(0)?, row.get(1)?);
             let y = ParamValue::from_columns(row.get(2)?, row.get(3)?);
@@ -296,8 +336,8 @@ impl Pivot {
                 let mut line = vec![y.to_string()];
                 line.extend(row.iter().map(|cell| match cell {
                     None => "-".to_string(),
-                    Some(PivotCell { mean, count: 1 }) => format_significant(*mean),
-                    Some(PivotCell { mean, count }) => format!("{} (n={count})", format_significant(*mean)),
+                    Some(PivotCell { mean, count: 1, .. }) => format_significant(*mean),
+                    Some(PivotCell { mean, count, .. }) => format!("{} (n={count})", format_significant(*mean)),
                 }));
                 line
             })
@@ -373,7 +413,13 @@ mod tests {
         let reals = |values: &[f64]| values.iter().map(|&v| ParamValue::Real(v)).collect::<Vec<_>>();
         assert_eq!(pivot.x_values, reals(&[0.1, 0.2, 0.3]));
         assert_eq!(pivot.y_values, reals(&[0.3, 0.5]));
-        let one = |mean| Some(PivotCell { mean, count: 1 });
+        let one = |mean| {
+            Some(PivotCell {
+                mean,
+                count: 1,
+                std: None,
+            })
+        };
         assert_eq!(
             pivot.cells,
             vec![vec![one(0.40), one(0.42), one(0.44)], vec![one(0.46), None, one(0.50)]]
@@ -401,8 +447,22 @@ mod tests {
         let pivot = store.pivot(campaign, "drag", "u_m_per_s", "dp_mean").unwrap();
         assert_eq!(pivot.unit, "Pa");
         assert_eq!(pivot.x_values, [ParamValue::Text("di_felice".into())]);
-        assert_eq!(pivot.cell(0, 0), Some(PivotCell { mean: 1000.0, count: 2 }));
-        assert_eq!(pivot.cell(1, 0), Some(PivotCell { mean: 1000.0, count: 1 }));
+        assert_eq!(
+            pivot.cell(0, 0),
+            Some(PivotCell {
+                mean: 1000.0,
+                count: 2,
+                std: Some(0.0)
+            })
+        );
+        assert_eq!(
+            pivot.cell(1, 0),
+            Some(PivotCell {
+                mean: 1000.0,
+                count: 1,
+                std: None
+            })
+        );
         assert!(pivot.to_table().contains("1000 (n=2)"), "{}", pivot.to_table());
     }
 
@@ -431,7 +491,31 @@ mod tests {
         finish(&mut store, "c", &[("k", f64::NAN, "1/s")]);
         let pivot = store.pivot(campaign, "u", "fill", "k").unwrap();
         assert_eq!(pivot.x_values, [ParamValue::Real(9.0), ParamValue::Real(10.0)]);
-        assert_eq!(pivot.cells, vec![vec![None, Some(PivotCell { mean: 1.5, count: 2 })]]);
+        assert_eq!(
+            pivot.cells,
+            vec![vec![
+                None,
+                Some(PivotCell {
+                    mean: 1.5,
+                    count: 2,
+                    std: Some(0.5f64.sqrt())
+                })
+            ]]
+        );
+        // The same jobs as a curve over u alone.
+        let curve = store.curve_where(campaign, "u", "k", &[]).unwrap();
+        assert_eq!(curve.y_values, [ParamValue::Text(String::new())]);
+        assert_eq!(
+            curve.cells,
+            vec![vec![
+                None,
+                Some(PivotCell {
+                    mean: 1.5,
+                    count: 2,
+                    std: Some(0.5f64.sqrt())
+                })
+            ]]
+        );
         assert!(pivot.to_table().contains("1.5 (n=2)"));
         assert!(pivot.to_table().contains("(n=K): mean over K jobs"));
 
@@ -439,7 +523,17 @@ mod tests {
         let one_seed = [("seed".to_string(), ParamValue::Real(2.0))];
         let pivot = store.pivot_where(campaign, "u", "fill", "k", &one_seed).unwrap();
         assert_eq!(pivot.x_values, [ParamValue::Real(9.0), ParamValue::Real(10.0)]);
-        assert_eq!(pivot.cells, vec![vec![None, Some(PivotCell { mean: 2.0, count: 1 })]]);
+        assert_eq!(
+            pivot.cells,
+            vec![vec![
+                None,
+                Some(PivotCell {
+                    mean: 2.0,
+                    count: 1,
+                    std: None
+                })
+            ]]
+        );
         assert!(
             pivot.to_table().contains("only jobs with seed = 2\n"),
             "{}",
