@@ -222,6 +222,21 @@ pub enum PlotPicture {
         #[arg(long)]
         out: Option<PathBuf>,
     },
+    /// A series column against time for each done job matching --where (at most 12), with the model its metric
+    /// was fitted with drawn over it (intensity_of_segregation: the mixing rate's exponential; core temperatures:
+    /// the h_w line).
+    Series {
+        /// The series column (a header name of the jobs' series.csv, e.g. intensity_of_segregation).
+        #[arg(long)]
+        column: String,
+        /// Only jobs whose parameter has this value (repeatable).
+        #[arg(long = "where", value_name = "PARAM=VALUE")]
+        filters: Vec<String>,
+        /// Output file: `.png` or `.svg` for that format only, otherwise a stem given both extensions (default
+        /// <dir>/plots/series-<column>[-<filters>]).
+        #[arg(long)]
+        out: Option<PathBuf>,
+    },
 }
 
 #[derive(Debug, clap::Args)]
@@ -447,6 +462,9 @@ pub fn run(cli: Cli) -> Result<i32> {
                     filters,
                     out,
                 } => crate::plot::curve(&dir, &x, lines.as_deref(), &metric, &filters, out.as_deref())?,
+                PlotPicture::Series { column, filters, out } => {
+                    crate::plot::series(&dir, &column, &filters, out.as_deref())?
+                }
             };
             let list: Vec<String> = written.iter().map(|p| p.display().to_string()).collect();
             emit(&format!("{}\n", list.join("\n")))?;

@@ -198,19 +198,7 @@ pub(crate) fn layout_of(
     let (store, id, campaign) = open(dir)?;
     let x = resolve_param(&store, x)?;
     let y = y.map(|y| resolve_param(&store, y)).transpose()?;
-    let mut wanted = Vec::new();
-    for filter in filters {
-        let Some((name, value)) = filter.split_once('=') else {
-            return Err(Error::Usage(format!(
-                "--where `{filter}`: expected PARAM=VALUE, e.g. radius_m=0.00135"
-            )));
-        };
-        let value = match value.trim().parse::<f64>() {
-            Ok(v) => store::ParamValue::Real(v),
-            Err(_) => store::ParamValue::Text(value.trim().to_string()),
-        };
-        wanted.push((resolve_param(&store, name.trim())?, value));
-    }
+    let wanted = parse_filters(&store, filters)?;
     let laid_out = match &y {
         Some(y) => store.pivot_where(id, &x, y, metric, &wanted),
         None => store.curve_where(id, &x, metric, &wanted),
@@ -222,6 +210,36 @@ pub(crate) fn layout_of(
         other => store_err(other),
     })?;
     Ok((p, campaign))
+}
+
+/// `--where PARAM=VALUE` filters with their parameters resolved (a usage error when malformed or unknown).
+fn parse_filters(store: &Store, filters: &[String]) -> Result<Vec<(String, store::ParamValue)>, Error> {
+    let mut wanted = Vec::new();
+    for filter in filters {
+        let Some((name, value)) = filter.split_once('=') else {
+            return Err(Error::Usage(format!(
+                "--where `{filter}`: expected PARAM=VALUE, e.g. radius_m=0.00135"
+            )));
+        };
+        let value = match value.trim().parse::<f64>() {
+            Ok(v) => store::ParamValue::Real(v),
+            Err(_) => store::ParamValue::Text(value.trim().to_string()),
+        };
+        wanted.push((resolve_param(store, name.trim())?, value));
+    }
+    Ok(wanted)
+}
+
+/// The done jobs of the campaign in `dir` matching `filters` (`PARAM=VALUE`), in the sweep's order, with the
+/// campaign: `plot series`.
+pub(crate) fn done_jobs_of(dir: &Path, filters: &[String]) -> Result<(Vec<String>, Campaign), Error> {
+    let (store, id, campaign) = open(dir)?;
+    let wanted = parse_filters(&store, filters)?;
+    let jobs = store.done_jobs_where(id, &wanted).map_err(|e| match e {
+        store::StoreError::UnknownParameter { .. } => Error::Usage(e.to_string()),
+        other => store_err(other),
+    })?;
+    Ok((jobs, campaign))
 }
 
 /// `granflow query --sql`.

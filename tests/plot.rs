@@ -9,7 +9,7 @@ use std::path::Path;
 
 use common::granflow;
 
-/// A small drum campaign: 3 log-spaced speeds × 2 fill levels, a few hundred steps each.
+/// A small drum campaign: 3 log-spaced speeds × 2 fill levels, 5,000 steps each.
 const CAMPAIGN: &str = r#"
 name: plot-mini
 seed: 3
@@ -25,7 +25,7 @@ base:
   fill:
     - lattice: { species: red, spacing_m: 0.0032, lo_m: [-0.02, -0.02, 0.0], hi_m: [0.0, 0.0, 0.0064], origin_m: [0.0016, 0.0016, 0.0016], inside_drum: drum }
     - lattice: { species: blue, spacing_m: 0.0032, lo_m: [0.0, -0.02, 0.0], hi_m: [0.02, 0.0, 0.0064], origin_m: [0.0016, 0.0016, 0.0016], inside_drum: drum }
-  time: { dt_s: 2.0e-5, end_time_s: 0.01 }
+  time: { dt_s: 2.0e-5, end_time_s: 0.1 }
   output: { series_every_steps: 100 }
 sweep:
   grid:
@@ -33,7 +33,8 @@ sweep:
     - zip:
         - { param: fill.0.lattice.hi_m.1, name: fill_top_m, values: [-0.006, 0.0] }
         - { param: fill.1.lattice.hi_m.1, values: [-0.006, 0.0] }
-metrics: [kinetic_energy_j, coordination_number]
+metrics: [kinetic_energy_j, coordination_number, mixing_rate_constant_per_s]
+analysis: { mixing_species: red }
 executor: { local: { max_parallel: 2 } }
 "#;
 
@@ -195,6 +196,62 @@ fn a_phase_diagram_is_drawn_as_png_and_svg_and_bad_requests_exit_2() {
         "two different parameters",
     );
 
+    // A series: IS(t) of the two jobs at 40 rpm, each with the exponential its mixing rate constant was fitted
+    // with; the legend's k is the stored metric's.
+    let printed = run_ok(
+        &[
+            "plot",
+            "c",
+            "series",
+            "--column",
+            "intensity_of_segregation",
+            "--where",
+            "rotation_rpm=40",
+        ],
+        dir,
+    );
+    let stem = "c/plots/series-intensity_of_segregation-rotation_rpm-40";
+    assert_eq!(
+        printed.lines().collect::<Vec<_>>(),
+        [format!("{stem}.png"), format!("{stem}.svg")]
+    );
+    assert!(png_colours(&dir.join(format!("{stem}.png"))) > 10);
+    let svg = std::fs::read_to_string(dir.join(format!("{stem}.svg"))).unwrap();
+    let stored = run_ok(
+        &[
+            "query",
+            "c",
+            "--sql",
+            "SELECT m.value FROM metrics m JOIN params p ON p.job_id = m.job_id \
+             WHERE m.name = 'mixing_rate_constant_per_s' AND p.name LIKE '%rotation_rpm' AND p.value_real = 40",
+            "--format",
+            "csv",
+        ],
+        dir,
+    );
+    let rates: Vec<f64> = stored.lines().skip(1).map(|l| l.trim().parse().unwrap()).collect();
+    assert_eq!(rates.len(), 2, "{stored}");
+    for text in [
+        "time_s [s]",
+        "intensity_of_segregation",
+        "fill_top_m=-0.006",
+        "fill_top_m=0.0",
+    ] {
+        assert!(svg_has(&svg, text), "the series SVG lacks the text `{text}`");
+    }
+    for rate in rates {
+        let k = granflow::plot::phase_diagram::significant(rate, 3);
+        assert!(
+            svg.lines().any(|l| l.trim().starts_with(&format!("fit: k = {k} 1/s"))),
+            "the series SVG lacks the fit with k = {k}"
+        );
+    }
+    fails_with_2(
+        &["plot", "c", "series", "--column", "intensity_of_segregaton"],
+        dir,
+        "has no column `intensity_of_segregaton`",
+    );
+
     // --out with an extension writes that format only; a `where` filter narrows the jobs.
     let printed = run_ok(
         &[
@@ -270,7 +327,7 @@ fn a_phase_diagram_is_drawn_as_png_and_svg_and_bad_requests_exit_2() {
     // A campaign with no finished job: its jobs 100 s long, the dispatcher interrupted (Ctrl-C) once they run.
     let unfinished = CAMPAIGN
         .replace("name: plot-mini", "name: plot-none")
-        .replace("end_time_s: 0.01", "end_time_s: 100.0");
+        .replace("end_time_s: 0.1", "end_time_s: 100.0");
     std::fs::write(dir.join("none.yaml"), unfinished).unwrap();
     let mut dispatcher = std::process::Command::new(env!("CARGO_BIN_EXE_granflow"))
         .args(["run", "none.yaml", "--out", "none", "--quiet"])

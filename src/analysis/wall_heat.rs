@@ -169,6 +169,21 @@ pub struct WallHeatFit {
     pub contact_area_m2: f64,
     /// h_w (eq. 5.21), W/(m² K).
     pub coefficient_w_per_m2_k: f64,
+    /// The fitted line's value at t = 0: ln((T_w − ⟨T_c⟩)/(T_w − T_0)) = intercept + slope · t.
+    pub intercept: f64,
+    /// T_w and T_0 of the fit, K.
+    pub wall_temperature_k: f64,
+    pub initial_core_temperature_k: f64,
+    /// The first and last sample times the fit used, s.
+    pub span_s: (f64, f64),
+}
+
+impl WallHeatFit {
+    /// The core temperature the fitted line gives at `t_s`, K.
+    pub fn core_temperature_k(&self, t_s: f64) -> f64 {
+        let (tw, t0) = (self.wall_temperature_k, self.initial_core_temperature_k);
+        tw - (tw - t0) * (self.intercept + self.slope_per_s * t_s).exp()
+    }
 }
 
 /// Fits ln((T_w − ⟨T_c⟩)/(T_w − T_0)) over the samples (t, ⟨T_c⟩) (non-finite ones and ones at or above T_w
@@ -213,6 +228,10 @@ pub fn wall_heat_transfer_coefficient(t_s: &[f64], core_k: &[f64], inputs: &Wall
         contact_time_s,
         contact_area_m2,
         coefficient_w_per_m2_k: coefficient,
+        intercept: my - slope * mt,
+        wall_temperature_k: tw,
+        initial_core_temperature_k: t0,
+        span_s: (t[0], t[t.len() - 1]),
     })
 }
 

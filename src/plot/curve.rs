@@ -17,7 +17,7 @@ use crate::units::{caption, parameter_unit};
 pub const SIZE: (u32, u32) = (1200, 900);
 
 /// The lines' colours in order (Tableau 10: distinct, readable on white, kind to colour-blind readers).
-const LINE_COLOURS: [RGBColor; 10] = [
+pub(crate) const LINE_COLOURS: [RGBColor; 10] = [
     RGBColor(31, 119, 180),
     RGBColor(255, 127, 14),
     RGBColor(44, 160, 44),

@@ -3,6 +3,7 @@
 //!
 //! - `phase_diagram.rs`: one metric over two swept parameters as a coloured map.
 //! - `curve.rs`: one metric against one parameter, a line per value of a second, replicates' error bars.
+//! - `series.rs`: a series column against time for chosen jobs, with the model their metric was fitted with.
 //!
 //! Every picture is written to a temporary file beside its destination and renamed into place, so a failure leaves
 //! nothing half-written; bad requests (an unknown parameter or metric, a campaign with no finished job that has the
@@ -10,6 +11,7 @@
 
 pub mod curve;
 pub mod phase_diagram;
+pub mod series;
 
 use std::io::Write;
 use std::path::{Path, PathBuf};
@@ -209,6 +211,50 @@ pub fn curve(
         curve::SIZE,
         |root| curve::draw(root, &pivot, &title),
         |root| curve::draw(root, &pivot, &title),
+    )
+}
+
+/// `granflow plot <dir> series`: `column` against time for the done jobs matching `filters` (at most
+/// [`series::MAX_JOBS`]), with the fitted model where the column has one. Returns the files written.
+pub fn series(dir: &Path, column: &str, filters: &[String], out: Option<&Path>) -> Result<Vec<PathBuf>, Error> {
+    let (jobs, campaign) = crate::inspect::done_jobs_of(dir, filters)?;
+    let selection = if filters.is_empty() {
+        String::new()
+    } else {
+        format!(" where {}", filters.join(", "))
+    };
+    if jobs.is_empty() {
+        return Err(Error::Usage(format!(
+            "campaign {}: no finished job{selection} (see `granflow status {}`)",
+            campaign.spec.name,
+            dir.display()
+        )));
+    }
+    if jobs.len() > series::MAX_JOBS {
+        return Err(Error::Usage(format!(
+            "campaign {}: {} finished jobs{selection}; a series picture draws at most {} (narrow it with --where)",
+            campaign.spec.name,
+            jobs.len(),
+            series::MAX_JOBS
+        )));
+    }
+    let mut lines = jobs
+        .iter()
+        .map(|job| series::job_line(&crate::campaign_dir::job_dir(dir, job), &campaign, column))
+        .collect::<Result<Vec<_>, _>>()?;
+    let shared = series::distinguish(&mut lines);
+    let mut stem = format!("series-{}", file_part(column));
+    if !filters.is_empty() {
+        stem.push_str(&format!("-{}", file_part(&filters.join("-"))));
+    }
+    let outputs = outputs(dir, out, &stem);
+    check_writable(&outputs)?;
+    let title = format!("{column} — {}", campaign.spec.name);
+    write_pictures(
+        &outputs,
+        series::SIZE,
+        |root| series::draw(root, &lines, column, &title, &shared),
+        |root| series::draw(root, &lines, column, &title, &shared),
     )
 }
 

@@ -212,6 +212,49 @@ impl Store {
         })
     }
 
+    /// The done jobs of the campaign whose parameters have the values of `filters` (all of them without filters), in
+    /// the sweep's order. A filter on a parameter the campaign does not sweep fails as in [`Store::pivot_where`].
+    pub fn done_jobs_where(
+        &self,
+        campaign_id: i64,
+        filters: &[(String, ParamValue)],
+    ) -> Result<Vec<String>, StoreError> {
+        self.require_campaign(campaign_id)?;
+        let action = format!("listing the done jobs of campaign {campaign_id}");
+        let parameters: Vec<String> = self
+            .strings(
+                "SELECT DISTINCT p.name FROM params p JOIN jobs j ON j.job_id = p.job_id
+                 WHERE j.campaign_id = ?1 ORDER BY p.name",
+                params![campaign_id],
+            )
+            .context(&self.path, &action)?;
+        if let Some((name, _)) = filters.iter().find(|(name, _)| !parameters.contains(name)) {
+            return Err(StoreError::UnknownParameter {
+                path: self.path.clone(),
+                campaign_id,
+                name: name.clone(),
+                available: parameters,
+            });
+        }
+        let mut jobs: Vec<String> = self
+            .strings(
+                "SELECT job_id FROM jobs WHERE campaign_id = ?1 AND status = ?2 ORDER BY ordinal",
+                params![campaign_id, JobStatus::Done],
+            )
+            .context(&self.path, &action)?;
+        for (name, wanted) in filters {
+            let matching: std::collections::HashSet<String> = self
+                .job_values(campaign_id, name)
+                .context(&self.path, &action)?
+                .into_iter()
+                .filter(|(_, value)| value.axis_cmp(wanted) == Ordering::Equal)
+                .map(|(job, _)| job)
+                .collect();
+            jobs.retain(|job| matching.contains(job));
+        }
+        Ok(jobs)
+    }
+
     /// (job id, value) of parameter `name` for every job of the campaign that has it.
     fn job_values(&self, campaign_id: i64, name: &str) -> rusqlite::Result<Vec<(String, ParamValue)>> {
         let mut stmt = self.conn.prepare_cached(

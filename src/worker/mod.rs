@@ -12,7 +12,7 @@
 
 mod prepared;
 pub mod protocol;
-mod reduce;
+pub(crate) mod reduce;
 pub mod rereduce;
 mod series_h5;
 

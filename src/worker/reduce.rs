@@ -618,7 +618,7 @@ fn stepped_onset_m_per_s(job: &JobSpec, built: &BuiltScenario, sim: &Simulation,
 /// `analysis.heating_fit_from_s` (default: when the wall starts heating) to the end, with T_0 the core's temperature
 /// at the first row from the wall's start, and the contact arc's mean over the fit window (returned beside the fit).
 /// `None` without a heated drum, its columns or enough rows.
-fn wall_heat(
+pub(crate) fn wall_heat(
     job: &JobSpec,
     sim: &Simulation,
     series: &Series,

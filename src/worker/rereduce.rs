@@ -8,16 +8,35 @@
 use std::path::Path;
 
 use super::{JobResult, read_job, read_result, reduce};
+use crate::campaign::JobSpec;
 use crate::campaign_dir::{job_spec_path, result_path};
 use crate::checkpoint::CheckpointSeries;
 use crate::engine::Simulation;
 use crate::error::Error;
+use crate::scenario::BuiltScenario;
 use crate::simulate::{attach_gas, checkpoint_meta};
 use crate::util::write_atomic;
 
 /// Recomputes the metrics of the finished job in `job_dir`, writes them into its `result.json` and returns the new
 /// result. Errors name the job directory and what is missing or does not match.
 pub fn reduce_again(job_dir: &Path) -> Result<JobResult, Error> {
+    let (job, built, sim, series, old) = final_state(job_dir)?;
+    let this_build = crate::provenance::build_id();
+    let result = JobResult {
+        metrics: reduce::metrics(&job, &built, &sim, &series),
+        reduced_by: (old.build != this_build).then_some(this_build),
+        ..old
+    };
+    let json = serde_json::to_string_pretty(&result).expect("results serialise");
+    write_atomic(&result_path(job_dir), json.as_bytes())?;
+    Ok(result)
+}
+
+/// A finished job's spec, built scenario, final simulation (restored from its last checkpoint, with its gas),
+/// series and result: what its metrics were reduced from (`granflow reduce`, `granflow plot series`'s fits).
+pub(crate) fn final_state(
+    job_dir: &Path,
+) -> Result<(JobSpec, BuiltScenario, Simulation, reduce::Series, JobResult), Error> {
     let fail = |what: String| Error::External(format!("{}: {what}", job_dir.display()));
     let job = read_job(job_dir)?;
     let old = read_result(job_dir)?.ok_or_else(|| fail("the job has no result.json (it has not finished)".into()))?;
@@ -43,13 +62,5 @@ pub fn reduce_again(job_dir: &Path) -> Result<JobResult, Error> {
     let mut sim = Simulation::restore(built.config.clone(), state, 1)?;
     attach_gas(&built, &mut sim, gas.as_ref())?;
     let series = reduce::Series::read(&job_dir.join("series.csv"))?;
-    let this_build = crate::provenance::build_id();
-    let result = JobResult {
-        metrics: reduce::metrics(&job, &built, &sim, &series),
-        reduced_by: (old.build != this_build).then_some(this_build),
-        ..old
-    };
-    let json = serde_json::to_string_pretty(&result).expect("results serialise");
-    write_atomic(&result_path(job_dir), json.as_bytes())?;
-    Ok(result)
+    Ok((job, built, sim, series, old))
 }
