@@ -289,10 +289,9 @@ pub fn dry(
         let thermal_mass = p.mass_kg[i] * heat_capacity_j_per_kg_k[p.species[i].index()];
         p.temperature_k[i] -= m_kg * latent / thermal_mass;
     }
-    for i in 0..p.len() {
-        let f = fraction[i];
+    for (liquid, &f) in p.liquid_m3.iter_mut().zip(&fraction) {
         if f > 0.0 {
-            p.liquid_m3[i] = if f >= 1.0 { 0.0 } else { p.liquid_m3[i] * (1.0 - f) };
+            *liquid = if f >= 1.0 { 0.0 } else { *liquid * (1.0 - f) };
         }
     }
     let (pairs, walls) = (
