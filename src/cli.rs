@@ -3,7 +3,7 @@
 
 use std::path::{Path, PathBuf};
 
-use clap::{Parser, Subcommand};
+use clap::{Args, Parser, Subcommand};
 
 use crate::bench::{DemBenchOptions, bench_dem};
 use crate::campaign::Campaign;
@@ -179,6 +179,18 @@ pub enum Command {
     },
 }
 
+/// Which done jobs a picture draws and where it goes (every picture takes these).
+#[derive(Debug, Args)]
+pub struct Chosen {
+    /// Only jobs whose parameter has this value (repeatable), as `query --pivot --where`.
+    #[arg(long = "where", value_name = "PARAM=VALUE")]
+    pub filters: Vec<String>,
+    /// Output file: `.png` or `.svg` for that format only, otherwise a stem given both extensions (default: named
+    /// after the picture inside <dir>/plots/).
+    #[arg(long)]
+    pub out: Option<PathBuf>,
+}
+
 /// The pictures `granflow plot` draws.
 #[derive(Debug, Subcommand)]
 pub enum PlotPicture {
@@ -194,13 +206,12 @@ pub enum PlotPicture {
         /// The metric in the cells (the mean over jobs that share a cell).
         #[arg(long)]
         metric: String,
-        /// Only jobs whose parameter has this value (repeatable), as `query --pivot --where`.
-        #[arg(long = "where", value_name = "PARAM=VALUE")]
-        filters: Vec<String>,
-        /// Output file: `.png` or `.svg` for that format only, otherwise a stem given both extensions (default
-        /// <dir>/plots/phase-<metric>-<x>-<y>).
+        /// A classification drawn as markers over the cells: a second metric with at most 4 distinct values (e.g.
+        /// wet_phase_mixed, seed 000's M/S rule on Ca_g), one shape per value, named under the map.
         #[arg(long)]
-        out: Option<PathBuf>,
+        markers: Option<String>,
+        #[command(flatten)]
+        chosen: Chosen,
     },
     /// A metric against one swept parameter, one line per value of a second (`--lines`); each point the mean over
     /// the jobs at it (replicates, other parameters) with their standard deviation as an error bar.
@@ -214,13 +225,8 @@ pub enum PlotPicture {
         /// The metric along y.
         #[arg(long)]
         metric: String,
-        /// Only jobs whose parameter has this value (repeatable), as `query --pivot --where`.
-        #[arg(long = "where", value_name = "PARAM=VALUE")]
-        filters: Vec<String>,
-        /// Output file: `.png` or `.svg` for that format only, otherwise a stem given both extensions (default
-        /// <dir>/plots/curve-<metric>-<x>[-by-<lines>]).
-        #[arg(long)]
-        out: Option<PathBuf>,
+        #[command(flatten)]
+        chosen: Chosen,
     },
     /// A series column against time for each done job matching --where (at most 12), with the model its metric
     /// was fitted with drawn over it (intensity_of_segregation: the mixing rate's exponential; core temperatures:
@@ -229,13 +235,15 @@ pub enum PlotPicture {
         /// The series column (a header name of the jobs' series.csv, e.g. intensity_of_segregation).
         #[arg(long)]
         column: String,
-        /// Only jobs whose parameter has this value (repeatable).
-        #[arg(long = "where", value_name = "PARAM=VALUE")]
-        filters: Vec<String>,
-        /// Output file: `.png` or `.svg` for that format only, otherwise a stem given both extensions (default
-        /// <dir>/plots/series-<column>[-<filters>]).
-        #[arg(long)]
-        out: Option<PathBuf>,
+        #[command(flatten)]
+        chosen: Chosen,
+    },
+    /// The pressure drop over the bed's weight per area against the gas velocity through the gas.inflow_levels
+    /// cycle of each done job matching --where (at most 12), with U_mf,df, U_mf,th, U_mf,in and the stepped onset
+    /// (as the job's metrics read them) marked.
+    Fluidization {
+        #[command(flatten)]
+        chosen: Chosen,
     },
 }
 
@@ -452,18 +460,35 @@ pub fn run(cli: Cli) -> Result<i32> {
                     x,
                     y,
                     metric,
-                    filters,
-                    out,
-                } => crate::plot::phase(&dir, &x, &y, &metric, &filters, out.as_deref())?,
+                    markers,
+                    chosen,
+                } => crate::plot::phase(
+                    &dir,
+                    &x,
+                    &y,
+                    &metric,
+                    markers.as_deref(),
+                    &chosen.filters,
+                    chosen.out.as_deref(),
+                )?,
                 PlotPicture::Curve {
                     x,
                     lines,
                     metric,
-                    filters,
-                    out,
-                } => crate::plot::curve(&dir, &x, lines.as_deref(), &metric, &filters, out.as_deref())?,
-                PlotPicture::Series { column, filters, out } => {
-                    crate::plot::series(&dir, &column, &filters, out.as_deref())?
+                    chosen,
+                } => crate::plot::curve(
+                    &dir,
+                    &x,
+                    lines.as_deref(),
+                    &metric,
+                    &chosen.filters,
+                    chosen.out.as_deref(),
+                )?,
+                PlotPicture::Series { column, chosen } => {
+                    crate::plot::series(&dir, &column, &chosen.filters, chosen.out.as_deref())?
+                }
+                PlotPicture::Fluidization { chosen } => {
+                    crate::plot::fluidization(&dir, &chosen.filters, chosen.out.as_deref())?
                 }
             };
             let list: Vec<String> = written.iter().map(|p| p.display().to_string()).collect();

@@ -5,7 +5,7 @@ mod common;
 
 use std::path::Path;
 
-use common::granflow;
+use common::{granflow, granflow_ok};
 use granflow::checkpoint::CheckpointSeries;
 use granflow::engine::gas::coupled::GasSnapshot;
 use granflow::engine::state::{SimState, first_difference};
@@ -56,7 +56,7 @@ fn final_state(dir: &Path) -> SimState {
 fn final_gas(dir: &Path, name: &str, text: &str) -> GasSnapshot {
     let file = format!("{name}.yaml");
     std::fs::write(dir.join(&file), text).unwrap();
-    run_ok(&["simulate", &file, "--out", name, "--quiet"], dir);
+    granflow_ok(&["simulate", &file, "--out", name, "--quiet"], dir);
     final_state(&dir.join(name)).gas.expect("the checkpoint holds the gas")
 }
 
@@ -79,16 +79,6 @@ fn column_values(series: &str, name: &str) -> Vec<f64> {
 /// The value of column `name` in the last row of series text `series`.
 fn last_row_value(series: &str, name: &str) -> f64 {
     *column_values(series, name).last().expect("a row")
-}
-
-fn run_ok(args: &[&str], cwd: &Path) -> String {
-    let out = granflow(args, cwd);
-    assert!(
-        out.status.success(),
-        "granflow {args:?} failed: {}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    String::from_utf8_lossy(&out.stderr).into_owned()
 }
 
 #[test]
@@ -131,7 +121,7 @@ fn a_piso_step_ends_with_continuity_and_the_bed_carries_its_weight() {
     let dir = tmp.path();
     let run = |name: &str, extra: &str| {
         std::fs::write(dir.join(format!("{name}.yaml")), bed(0.03, extra)).unwrap();
-        run_ok(&["simulate", &format!("{name}.yaml"), "--out", name, "--quiet"], dir);
+        granflow_ok(&["simulate", &format!("{name}.yaml"), "--out", name, "--quiet"], dir);
         std::fs::read_to_string(dir.join(format!("{name}/series.csv"))).unwrap()
     };
     let piso = run("piso", "  solver: { pressure_velocity: { piso: {} } }");
@@ -185,9 +175,9 @@ fn restart_is_exact(extra: &str) {
     let tmp = tempfile::tempdir().expect("temp dir");
     let dir = tmp.path();
     std::fs::write(dir.join("bed.yaml"), bed(0.03, extra)).expect("write scenario");
-    run_ok(&["simulate", "bed.yaml", "--out", "whole", "--quiet"], dir);
+    granflow_ok(&["simulate", "bed.yaml", "--out", "whole", "--quiet"], dir);
     // 1503 steps: the stop falls 5 DEM steps into a gas step (the drag reaction sum is mid-way).
-    run_ok(
+    granflow_ok(
         &[
             "simulate",
             "bed.yaml",
@@ -213,7 +203,7 @@ fn restart_is_exact(extra: &str) {
         extra.contains("every_gas_step"),
         "held drag in the checkpoint exactly when the scenario holds it"
     );
-    let log = run_ok(&["simulate", "bed.yaml", "--out", "split", "--threads", "1"], dir);
+    let log = granflow_ok(&["simulate", "bed.yaml", "--out", "split", "--threads", "1"], dir).stderr;
     assert!(log.contains("resuming from"), "{log}");
     let whole = final_state(&dir.join("whole"));
     let split = final_state(&dir.join("split"));
@@ -243,7 +233,7 @@ fn the_series_holds_the_first_node_pressure_drop_and_the_weight_above_that_node(
     let dir = tmp.path();
     let text = bed(0.01, "").replace("series_every_steps: 70", "series_every_steps: 50");
     std::fs::write(dir.join("bed.yaml"), text).unwrap();
-    run_ok(&["simulate", "bed.yaml", "--out", "bed", "--quiet"], dir);
+    granflow_ok(&["simulate", "bed.yaml", "--out", "bed", "--quiet"], dir);
     let state = final_state(&dir.join("bed"));
     assert_eq!(state.step, 1000);
     let series = std::fs::read_to_string(dir.join("bed/series.csv")).unwrap();
@@ -294,12 +284,12 @@ fn the_net_forces_by_mechanism_close_the_momentum_balance_of_a_cohesive_bed() {
         )
         .replace("superficial_velocity_m_per_s: 2.5", "superficial_velocity_m_per_s: 1.0");
     std::fs::write(dir.join("bed.yaml"), text).unwrap();
-    run_ok(
+    granflow_ok(
         &["simulate", "bed.yaml", "--out", "bed", "--max-steps", "2000", "--quiet"],
         dir,
     );
     let before = final_state(&dir.join("bed"));
-    run_ok(&["simulate", "bed.yaml", "--out", "bed", "--quiet"], dir);
+    granflow_ok(&["simulate", "bed.yaml", "--out", "bed", "--quiet"], dir);
     let after = final_state(&dir.join("bed"));
     assert_eq!((before.step, after.step), (2000, 3000));
     let momentum = |s: &SimState| -> f64 {
@@ -387,7 +377,7 @@ fn cohesion_switched_off_between_particles_and_at_the_distributor_leaves_a_dry_b
     let mut states = Vec::new();
     for (name, extra) in &cases {
         std::fs::write(dir.join(format!("{name}.yaml")), landing(extra)).unwrap();
-        run_ok(&["simulate", &format!("{name}.yaml"), "--out", name, "--quiet"], dir);
+        granflow_ok(&["simulate", &format!("{name}.yaml"), "--out", name, "--quiet"], dir);
         states.push(final_state(&dir.join(name)));
     }
     let bits = |s: &SimState| -> Vec<u64> {
@@ -421,7 +411,7 @@ fn resuming_a_series_with_other_columns_is_refused_and_the_series_kept() {
     let tmp = tempfile::tempdir().expect("temp dir");
     let dir = tmp.path();
     std::fs::write(dir.join("bed.yaml"), bed(0.01, "")).unwrap();
-    run_ok(
+    granflow_ok(
         &["simulate", "bed.yaml", "--out", "bed", "--max-steps", "500", "--quiet"],
         dir,
     );
@@ -603,7 +593,7 @@ fn a_three_dimensional_bed_runs_with_a_three_dimensional_gas() {
         .replace("cells: [4, 12, 1]", "cells: [4, 12, 2]");
     assert!(text.contains("cells: [4, 12, 2]") && text.contains("0.0066"));
     std::fs::write(dir.join("bed3d.yaml"), text).unwrap();
-    run_ok(
+    granflow_ok(
         &["simulate", "bed3d.yaml", "--out", "bed3d", "--quiet", "--threads", "2"],
         dir,
     );
@@ -626,11 +616,11 @@ fn cell_averaged_drag_gives_the_same_bits_on_one_and_two_threads() {
     let tmp = tempfile::tempdir().expect("temp dir");
     let dir = tmp.path();
     std::fs::write(dir.join("bed.yaml"), bed(0.01, "  drag_velocities: cell_averaged")).unwrap();
-    run_ok(
+    granflow_ok(
         &["simulate", "bed.yaml", "--out", "one", "--quiet", "--threads", "1"],
         dir,
     );
-    run_ok(
+    granflow_ok(
         &["simulate", "bed.yaml", "--out", "two", "--quiet", "--threads", "2"],
         dir,
     );

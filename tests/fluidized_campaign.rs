@@ -4,7 +4,8 @@
 
 mod common;
 
-use common::granflow;
+use common::{granflow, granflow_ok, png_colours, svg_has};
+use granflow::plot::phase_diagram::significant;
 
 fn campaign(check_range: &str) -> String {
     format!(
@@ -152,6 +153,21 @@ fn a_gas_cycle_reduces_to_seed_001s_cycle_metrics() {
     let ratios = run_and_read(dir, "cycle", "pressure_overshoot_ratio");
     assert_eq!(ratios.len(), 2, "{ratios:?}");
     assert!(ratios.iter().all(|r| r.is_finite() && *r > 0.0), "{ratios:?}");
+    // The cycle as a picture: both jobs' branches, each named by what differs between them (the density).
+    let printed = granflow_ok(&["plot", "cycle", "fluidization"], dir).stdout;
+    assert_eq!(
+        printed.lines().collect::<Vec<_>>(),
+        ["cycle/plots/fluidization.png", "cycle/plots/fluidization.svg"]
+    );
+    assert!(png_colours(&dir.join("cycle/plots/fluidization.png")) > 20);
+    let svg = std::fs::read_to_string(dir.join("cycle/plots/fluidization.svg")).unwrap();
+    for density in ["1000", "2000"] {
+        for branch in ["falling branch", "rising branch"] {
+            let text = format!("density_kg_per_m3={density}.0: {branch}");
+            assert!(svg_has(&svg, &text), "the cycle's SVG lacks `{text}`");
+        }
+    }
+    assert!(svg_has(&svg, "gas superficial velocity [m/s]"));
     // Seed 001's reading: the first node against W'/A. The same runs (the analysis does not change the physics):
     // the bottom row of beads (a tenth of the bed) sits below the node and W'/A is 0.9 W/A, but the node also
     // leaves out the bottom half-cell of ΔP (4.2 of the bed's 30 mm, 14 % of a uniform packed bed's drop): ΔP* falls
@@ -224,6 +240,11 @@ fn a_bed_stepped_up_through_gas_levels_reduces_to_its_onset_velocity() {
     let onset = run_and_read(dir, "steps", "stepped_fluidization_velocity_m_per_s")[0];
     println!("stepped onset: {onset} m/s");
     assert!((1.5..=2.0).contains(&onset), "{onset}");
+    // The picture marks the stored onset (the same function on the same levels), under the job's parameters.
+    granflow_ok(&["plot", "steps", "fluidization", "--out", "steps.svg"], dir);
+    let svg = std::fs::read_to_string(dir.join("steps.svg")).unwrap();
+    let text = format!("stepped onset = {} m/s", significant(onset, 4));
+    assert!(svg_has(&svg, &text), "the stepped cycle's SVG lacks `{text}`");
 }
 
 /// Runs `<name>.yaml` in `dir` into `<name>/` and returns every job's value of `metric`, in sweep order.

@@ -5,9 +5,7 @@
 
 mod common;
 
-use std::path::Path;
-
-use common::granflow;
+use common::{granflow_fails_with_2, granflow_ok, png_colours, svg_has};
 
 /// A small drum campaign: 3 log-spaced speeds × 2 fill levels, 5,000 steps each.
 const CAMPAIGN: &str = r#"
@@ -38,54 +36,14 @@ analysis: { mixing_species: red }
 executor: { local: { max_parallel: 2 } }
 "#;
 
-fn run_ok(args: &[&str], cwd: &Path) -> String {
-    let out = granflow(args, cwd);
-    assert!(
-        out.status.success(),
-        "granflow {args:?} failed: {}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    String::from_utf8_lossy(&out.stdout).into_owned()
-}
-
-fn fails_with_2(args: &[&str], cwd: &Path, message: &str) {
-    let out = granflow(args, cwd);
-    let stderr = String::from_utf8_lossy(&out.stderr);
-    assert_eq!(out.status.code(), Some(2), "granflow {args:?}: {stderr}");
-    assert!(
-        stderr.contains(message),
-        "granflow {args:?}: expected `{message}` in: {stderr}"
-    );
-}
-
-/// The number of distinct colours of the 1200 × 900 PNG at `path` (fails on another size).
-fn png_colours(path: &Path) -> usize {
-    let decoder = png::Decoder::new(std::fs::File::open(path).unwrap());
-    let mut reader = decoder.read_info().expect("a PNG");
-    let mut pixels = vec![0; reader.output_buffer_size()];
-    let info = reader.next_frame(&mut pixels).expect("its pixels");
-    assert_eq!((info.width, info.height), (1200, 900), "{}", path.display());
-    let stride = info.line_size / info.width as usize;
-    let mut colours = std::collections::HashSet::new();
-    for px in pixels[..info.buffer_size()].chunks(stride) {
-        colours.insert(px.to_vec());
-    }
-    colours.len()
-}
-
-/// Whether the SVG text at `svg` holds `text` as a text element's content (plotters writes each on its own line).
-fn svg_has(svg: &str, text: &str) -> bool {
-    svg.lines().any(|l| l.trim() == text)
-}
-
 #[test]
 fn a_phase_diagram_is_drawn_as_png_and_svg_and_bad_requests_exit_2() {
     let tmp = tempfile::tempdir().expect("temp dir");
     let dir = tmp.path();
     std::fs::write(dir.join("c.yaml"), CAMPAIGN).unwrap();
-    run_ok(&["run", "c.yaml", "--out", "c"], dir);
+    granflow_ok(&["run", "c.yaml", "--out", "c"], dir);
 
-    let printed = run_ok(
+    let printed = granflow_ok(
         &[
             "plot",
             "c",
@@ -98,7 +56,8 @@ fn a_phase_diagram_is_drawn_as_png_and_svg_and_bad_requests_exit_2() {
             "kinetic_energy_j",
         ],
         dir,
-    );
+    )
+    .stdout;
     let files: Vec<&str> = printed.lines().collect();
     let stem = "c/plots/phase-kinetic_energy_j-rotation_rpm-fill_top_m";
     assert_eq!(files, [format!("{stem}.png"), format!("{stem}.svg")]);
@@ -124,7 +83,7 @@ fn a_phase_diagram_is_drawn_as_png_and_svg_and_bad_requests_exit_2() {
 
     // A curve: the metric against the speed, a line per fill level; then one line averaging both fills, with the
     // two jobs' standard deviation as error bars.
-    let printed = run_ok(
+    let printed = granflow_ok(
         &[
             "plot",
             "c",
@@ -137,7 +96,8 @@ fn a_phase_diagram_is_drawn_as_png_and_svg_and_bad_requests_exit_2() {
             "kinetic_energy_j",
         ],
         dir,
-    );
+    )
+    .stdout;
     let stem = "c/plots/curve-kinetic_energy_j-rotation_rpm-by-fill_top_m";
     assert_eq!(
         printed.lines().collect::<Vec<_>>(),
@@ -156,7 +116,7 @@ fn a_phase_diagram_is_drawn_as_png_and_svg_and_bad_requests_exit_2() {
     ] {
         assert!(svg_has(&svg, text), "the curve's SVG lacks the text `{text}`");
     }
-    run_ok(
+    granflow_ok(
         &[
             "plot",
             "c",
@@ -180,7 +140,7 @@ fn a_phase_diagram_is_drawn_as_png_and_svg_and_bad_requests_exit_2() {
         lines_drawn(&one),
         lines_drawn(&svg)
     );
-    fails_with_2(
+    granflow_fails_with_2(
         &[
             "plot",
             "c",
@@ -198,7 +158,7 @@ fn a_phase_diagram_is_drawn_as_png_and_svg_and_bad_requests_exit_2() {
 
     // A series: IS(t) of the two jobs at 40 rpm, each with the exponential its mixing rate constant was fitted
     // with; the legend's k is the stored metric's.
-    let printed = run_ok(
+    let printed = granflow_ok(
         &[
             "plot",
             "c",
@@ -209,7 +169,8 @@ fn a_phase_diagram_is_drawn_as_png_and_svg_and_bad_requests_exit_2() {
             "rotation_rpm=40",
         ],
         dir,
-    );
+    )
+    .stdout;
     let stem = "c/plots/series-intensity_of_segregation-rotation_rpm-40";
     assert_eq!(
         printed.lines().collect::<Vec<_>>(),
@@ -217,7 +178,7 @@ fn a_phase_diagram_is_drawn_as_png_and_svg_and_bad_requests_exit_2() {
     );
     assert!(png_colours(&dir.join(format!("{stem}.png"))) > 10);
     let svg = std::fs::read_to_string(dir.join(format!("{stem}.svg"))).unwrap();
-    let stored = run_ok(
+    let stored = granflow_ok(
         &[
             "query",
             "c",
@@ -228,7 +189,8 @@ fn a_phase_diagram_is_drawn_as_png_and_svg_and_bad_requests_exit_2() {
             "csv",
         ],
         dir,
-    );
+    )
+    .stdout;
     let rates: Vec<f64> = stored.lines().skip(1).map(|l| l.trim().parse().unwrap()).collect();
     assert_eq!(rates.len(), 2, "{stored}");
     for text in [
@@ -246,14 +208,14 @@ fn a_phase_diagram_is_drawn_as_png_and_svg_and_bad_requests_exit_2() {
             "the series SVG lacks the fit with k = {k}"
         );
     }
-    fails_with_2(
+    granflow_fails_with_2(
         &["plot", "c", "series", "--column", "intensity_of_segregaton"],
         dir,
         "has no column `intensity_of_segregaton`",
     );
 
     // --out with an extension writes that format only; a `where` filter narrows the jobs.
-    let printed = run_ok(
+    let printed = granflow_ok(
         &[
             "plot",
             "c",
@@ -268,13 +230,86 @@ fn a_phase_diagram_is_drawn_as_png_and_svg_and_bad_requests_exit_2() {
             "mine.svg",
         ],
         dir,
-    );
+    )
+    .stdout;
     assert_eq!(printed.trim(), "mine.svg");
     assert!(dir.join("mine.svg").is_file() && !dir.join("mine.png").exists());
 
+    // A classification as markers: the coordination number of the two fills at 10 rpm (two values, two shapes,
+    // each named under the map); over all six cells it has six values, too many to be a classification.
+    let stored = granflow_ok(
+        &[
+            "query",
+            "c",
+            "--sql",
+            "SELECT m.value FROM metrics m JOIN params p USING (job_id) WHERE m.name = 'coordination_number' \
+             AND p.name = 'rotation_rpm' AND p.value_real = 10.0",
+            "--format",
+            "csv",
+        ],
+        dir,
+    )
+    .stdout;
+    let classes: Vec<f64> = stored.lines().skip(1).map(|l| l.parse().unwrap()).collect();
+    assert_eq!(classes.len(), 2, "{stored}");
+    let printed = granflow_ok(
+        &[
+            "plot",
+            "c",
+            "phase",
+            "--x",
+            "rotation_rpm",
+            "--y",
+            "fill_top_m",
+            "--metric",
+            "kinetic_energy_j",
+            "--markers",
+            "coordination_number",
+            "--where",
+            "rotation_rpm=10",
+            "--out",
+            "marked",
+        ],
+        dir,
+    )
+    .stdout;
+    assert_eq!(printed.lines().collect::<Vec<_>>(), ["marked.png", "marked.svg"]);
+    assert!(png_colours(&dir.join("marked.png")) > 50);
+    let svg = std::fs::read_to_string(dir.join("marked.svg")).unwrap();
+    for value in &classes {
+        let text = format!(
+            "coordination_number = {}",
+            granflow::plot::phase_diagram::significant(*value, 3)
+        );
+        assert!(svg_has(&svg, &text), "the marked SVG lacks the legend `{text}`");
+    }
+    granflow_fails_with_2(
+        &[
+            "plot",
+            "c",
+            "phase",
+            "--x",
+            "rotation_rpm",
+            "--y",
+            "fill_top_m",
+            "--metric",
+            "kinetic_energy_j",
+            "--markers",
+            "coordination_number",
+        ],
+        dir,
+        "`coordination_number` has 6 distinct values over these cells; markers draw a classification of at most 4",
+    );
+    // A fluidization cycle needs gas levels; a drum has none.
+    granflow_fails_with_2(
+        &["plot", "c", "fluidization", "--where", "rotation_rpm=10"],
+        dir,
+        "no fluidization cycle to draw",
+    );
+
     // Bad requests: exit 2, a message naming what is wrong, nothing written.
     let before = std::fs::read_dir(dir.join("c/plots")).unwrap().count();
-    fails_with_2(
+    granflow_fails_with_2(
         &[
             "plot",
             "c",
@@ -289,7 +324,7 @@ fn a_phase_diagram_is_drawn_as_png_and_svg_and_bad_requests_exit_2() {
         dir,
         "kinetic_energi_j",
     );
-    fails_with_2(
+    granflow_fails_with_2(
         &[
             "plot",
             "c",
@@ -305,7 +340,7 @@ fn a_phase_diagram_is_drawn_as_png_and_svg_and_bad_requests_exit_2() {
         "no swept parameter `rotation_rmp`",
     );
     std::fs::write(dir.join("blocker"), "a file").unwrap();
-    fails_with_2(
+    granflow_fails_with_2(
         &[
             "plot",
             "c",
@@ -348,7 +383,7 @@ fn a_phase_diagram_is_drawn_as_png_and_svg_and_bad_requests_exit_2() {
         .expect("kill runs");
     assert!(interrupt.success());
     dispatcher.wait().expect("the dispatcher stops");
-    fails_with_2(
+    granflow_fails_with_2(
         &[
             "plot",
             "none",

@@ -10,7 +10,7 @@ mod common;
 
 use std::path::Path;
 
-use common::{built, granflow, simulation};
+use common::{built, granflow_ok, simulation};
 use granflow::checkpoint::{CheckpointSeries, read_checkpoint};
 use granflow::engine::state::{SimState, first_difference};
 
@@ -46,25 +46,15 @@ fn final_state(dir: &Path) -> SimState {
     loaded.state
 }
 
-fn run_ok(args: &[&str], cwd: &Path) -> String {
-    let out = granflow(args, cwd);
-    assert!(
-        out.status.success(),
-        "granflow {args:?} failed: {}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    String::from_utf8_lossy(&out.stderr).into_owned()
-}
-
 #[test]
 fn restart_in_a_fresh_process_is_bit_identical() {
     let tmp = tempfile::tempdir().expect("temp dir");
     let dir = tmp.path();
     std::fs::write(dir.join("drum.yaml"), DRUM).expect("write scenario");
 
-    run_ok(&["simulate", "drum.yaml", "--out", "whole", "--quiet"], dir);
+    granflow_ok(&["simulate", "drum.yaml", "--out", "whole", "--quiet"], dir);
     // N = 1500 steps with 2 threads, stop; then the rest in a new process on 1 thread.
-    run_ok(
+    granflow_ok(
         &[
             "simulate",
             "drum.yaml",
@@ -80,7 +70,7 @@ fn restart_in_a_fresh_process_is_bit_identical() {
     );
     let middle = final_state(&dir.join("split"));
     assert_eq!(middle.step, 1500);
-    let log = run_ok(&["simulate", "drum.yaml", "--out", "split", "--threads", "1"], dir);
+    let log = granflow_ok(&["simulate", "drum.yaml", "--out", "split", "--threads", "1"], dir).stderr;
     assert!(log.contains("resuming from"), "{log}");
 
     let whole = final_state(&dir.join("whole"));
@@ -172,7 +162,7 @@ fn corrupt_newest_checkpoint_falls_back_to_the_previous_one() {
     let tmp = tempfile::tempdir().expect("temp dir");
     let dir = tmp.path();
     std::fs::write(dir.join("drum.yaml"), DRUM).expect("write scenario");
-    run_ok(
+    granflow_ok(
         &[
             "simulate",
             "drum.yaml",
@@ -195,7 +185,7 @@ fn corrupt_newest_checkpoint_falls_back_to_the_previous_one() {
     std::fs::write(&newest, &bytes).expect("write");
     assert!(read_checkpoint(&newest).is_err());
 
-    let log = run_ok(&["simulate", "drum.yaml", "--out", "run", "--max-steps", "10"], dir);
+    let log = granflow_ok(&["simulate", "drum.yaml", "--out", "run", "--max-steps", "10"], dir).stderr;
     let name = newest.file_name().expect("name").to_string_lossy().into_owned();
     assert!(
         log.contains(&name) && log.contains("using"),
@@ -209,7 +199,7 @@ fn truncated_checkpoint_is_rejected_with_its_name() {
     let tmp = tempfile::tempdir().expect("temp dir");
     let dir = tmp.path();
     std::fs::write(dir.join("drum.yaml"), DRUM).expect("write scenario");
-    run_ok(
+    granflow_ok(
         &["simulate", "drum.yaml", "--out", "run", "--max-steps", "500", "--quiet"],
         dir,
     );

@@ -8,7 +8,7 @@ mod common;
 use std::path::Path;
 use std::process::Command;
 
-use common::{final_state, granflow, wet_drying_kiln};
+use common::{final_state, granflow_ok, wet_drying_kiln};
 use serde_json::Value;
 
 /// Reads each index (`particles.pvd`, `gas.pvd`) and every file it lists with VTK's readers; prints, per index, one
@@ -63,15 +63,6 @@ fn range(values: impl IntoIterator<Item = f64>) -> (f64, f64) {
         .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), v| (lo.min(v), hi.max(v)))
 }
 
-fn run_ok(args: &[&str], cwd: &Path) {
-    let out = granflow(args, cwd);
-    assert!(
-        out.status.success(),
-        "{args:?}: {}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-}
-
 /// The wet, heated, drying kiln for 0.02 s with a snapshot every 5 ms.
 fn scenario() -> String {
     wet_drying_kiln().replace("end_time_s: 0.2 }", "end_time_s: 0.02 }")
@@ -82,7 +73,7 @@ fn scenario() -> String {
 fn snapshots_read_back_in_vtk_with_the_counts_ranges_and_times_granflow_holds() {
     let dir = tempfile::tempdir().unwrap();
     std::fs::write(dir.path().join("kiln.yaml"), scenario()).unwrap();
-    run_ok(&["simulate", "kiln.yaml", "--out", "run", "--quiet"], dir.path());
+    granflow_ok(&["simulate", "kiln.yaml", "--out", "run", "--quiet"], dir.path());
     let run = dir.path().join("run");
     let state = final_state(&run);
     let read = vtk_read(&run.join("snapshots"));
@@ -143,7 +134,7 @@ fn snapshots_read_back_in_vtk_with_the_counts_ranges_and_times_granflow_holds() 
     }
 
     // The same snapshots made afterwards from the checkpoints: the same bytes.
-    run_ok(&["snapshots", "run", "--out", "again"], dir.path());
+    granflow_ok(&["snapshots", "run", "--out", "again"], dir.path());
     let mut compared = 0;
     for entry in std::fs::read_dir(dir.path().join("again")).unwrap() {
         let name = entry.unwrap().file_name();
@@ -166,8 +157,8 @@ fn snapshots_read_back_in_vtk_with_the_counts_ranges_and_times_granflow_holds() 
 fn a_resumed_run_lists_every_snapshot_once_with_the_same_bytes() {
     let dir = tempfile::tempdir().unwrap();
     std::fs::write(dir.path().join("kiln.yaml"), scenario()).unwrap();
-    run_ok(&["simulate", "kiln.yaml", "--out", "whole", "--quiet"], dir.path());
-    run_ok(
+    granflow_ok(&["simulate", "kiln.yaml", "--out", "whole", "--quiet"], dir.path());
+    granflow_ok(
         &[
             "simulate",
             "kiln.yaml",
@@ -180,7 +171,7 @@ fn a_resumed_run_lists_every_snapshot_once_with_the_same_bytes() {
         dir.path(),
     );
     // As if killed after the snapshot at step 750 (written) but before any later checkpoint.
-    run_ok(
+    granflow_ok(
         &[
             "simulate",
             "kiln.yaml",
@@ -204,7 +195,7 @@ fn a_resumed_run_lists_every_snapshot_once_with_the_same_bytes() {
         )
         .unwrap();
     }
-    run_ok(&["simulate", "kiln.yaml", "--out", "split", "--quiet"], dir.path());
+    granflow_ok(&["simulate", "kiln.yaml", "--out", "split", "--quiet"], dir.path());
     for name in [
         "particles.pvd",
         "gas.pvd",

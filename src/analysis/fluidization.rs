@@ -95,8 +95,9 @@ pub struct CycleLevel {
     pub pressure_drop_mean_pa: f64,
 }
 
-/// Seed 001's three velocities of one cycle (§6.4.2.1, Fig. 6.9; notes §4): the cycle first lowers the gas
-/// (defluidization branch, down to its slowest level) and then raises it again (fluidization branch).
+/// Seed 001's three velocities of one cycle (§6.4.2.1, Fig. 6.9; notes §4): seed 001's cycle first lowers the gas
+/// (defluidization branch, down to its slowest level) and then raises it again (fluidization branch); a cycle
+/// that rises first and then falls is read on the same two branches ([`cycle_branches`]).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct CycleVelocities {
     /// U_mf,df: the line through the falling branch's packed-bed points meets W/A.
@@ -118,15 +119,59 @@ pub struct CycleVelocities {
 /// whose mean ΔP happens to dip below 0.8 W/A at the top of the cycle is not a packed bed.
 const PACKED_FRACTION_OF_WEIGHT: f64 = 0.8;
 
-/// U_mf,df, U_mf,th, U_mf,in and the overshoot from the levels of one cycle in time order. The falling branch runs
-/// from the start to the first slowest level, the rising branch from there on.
-pub fn cycle_velocities(levels: &[CycleLevel], bed_weight_per_area_pa: f64) -> CycleVelocities {
+/// The two branches of a cycle of levels in time order, as index ranges. Seed 001's order, down then up: the
+/// falling branch is the run of non-increasing velocities that ends just before the first slowest level, the
+/// rising branch the run of non-decreasing velocities from the slowest level on. A cycle that rises first and then
+/// falls (a fresh bed fluidized, then defluidized): when it ends at its slowest level, the rising branch is the
+/// climb that led into the fall; when it starts at its slowest level, the falling branch is the fall after the
+/// climb's top. A branch with fewer than two levels is empty.
+pub fn cycle_branches(levels: &[CycleLevel]) -> (std::ops::Range<usize>, std::ops::Range<usize>) {
+    let v = |k: usize| levels[k].velocity_m_per_s;
     let slowest = levels
         .iter()
         .enumerate()
         .min_by(|a, b| a.1.velocity_m_per_s.total_cmp(&b.1.velocity_m_per_s))
         .map_or(0, |(k, _)| k);
-    let (falling, rising) = levels.split_at(slowest);
+    if levels.is_empty() {
+        return (0..0, 0..0);
+    }
+    let mut fall_start = slowest;
+    while fall_start > 0 && v(fall_start - 1) >= v(fall_start) {
+        fall_start -= 1;
+    }
+    let mut rise_end = slowest + 1;
+    while rise_end < levels.len() && v(rise_end) >= v(rise_end - 1) {
+        rise_end += 1;
+    }
+    let rising = if rise_end - slowest >= 2 {
+        slowest..rise_end
+    } else {
+        let mut rise_start = fall_start;
+        while rise_start > 0 && v(rise_start - 1) <= v(rise_start) {
+            rise_start -= 1;
+        }
+        rise_start..fall_start + 1
+    };
+    let falling = if fall_start < slowest {
+        fall_start..slowest
+    } else {
+        // No fall into the slowest level (it is the first): the fall after the rise's top, if any.
+        let top = rising.end - 1;
+        let mut fall_end = top + 1;
+        while fall_end < levels.len() && v(fall_end) <= v(fall_end - 1) {
+            fall_end += 1;
+        }
+        if fall_end - top >= 2 { top..fall_end } else { 0..0 }
+    };
+    (falling, rising)
+}
+
+/// U_mf,df, U_mf,th, U_mf,in and the overshoot from the levels of one cycle in time order, on the branches of
+/// [`cycle_branches`].
+pub fn cycle_velocities(levels: &[CycleLevel], bed_weight_per_area_pa: f64) -> CycleVelocities {
+    let (falling, rising) = cycle_branches(levels);
+    let rising_start = rising.start;
+    let (falling, rising) = (&levels[falling], &levels[rising]);
     // `towards_top`: the branch's levels from the slowest one outwards.
     let crossing = |towards_top: &mut dyn Iterator<Item = &CycleLevel>| {
         let packed: Vec<&CycleLevel> = towards_top
@@ -176,7 +221,7 @@ pub fn cycle_velocities(levels: &[CycleLevel], bed_weight_per_area_pa: f64) -> C
             _ => f64::NAN,
         },
         overshoot_ratio,
-        peak_level: top.map(|(k, _)| slowest + k),
+        peak_level: top.map(|(k, _)| rising_start + k),
     }
 }
 
@@ -227,6 +272,49 @@ mod tests {
 
     /// A cycle 2 → 0 → 2 m/s with W/A = 1000 Pa: falling packed branch ΔP = 500 u (crossing W/A at 2.0), rising
     /// packed branch ΔP = 600 u (crossing at 1.667) and an overshoot to 1150 Pa at 1.8 m/s.
+    fn levels(velocities: &[f64]) -> Vec<CycleLevel> {
+        velocities
+            .iter()
+            .map(|&u| CycleLevel {
+                velocity_m_per_s: u,
+                pressure_drop_mean_pa: u,
+            })
+            .collect()
+    }
+
+    #[test]
+    fn a_cycle_splits_into_its_falling_and_rising_branches_in_either_order() {
+        // Seed 001's order: down, then up (the slowest level starts the rising branch).
+        assert_eq!(cycle_branches(&levels(&[1.0, 0.5, 0.0, 0.5, 1.0, 1.0])), (0..2, 2..6));
+        // Only up (D3's steps): no falling branch.
+        assert_eq!(cycle_branches(&levels(&[0.8, 1.0, 1.2])), (0..0, 0..3));
+        // Up, then down to below the start: the climb, then the fall from the top.
+        assert_eq!(cycle_branches(&levels(&[0.8, 1.0, 1.2, 1.0, 0.6, 0.4])), (2..5, 0..3));
+        // Up, then down to above the start.
+        assert_eq!(cycle_branches(&levels(&[0.4, 1.0, 1.2, 1.0, 0.6])), (2..5, 0..3));
+    }
+
+    #[test]
+    fn a_cycle_that_rises_first_reads_the_same_velocities_as_one_that_falls_first() {
+        // ΔP = 2u Pa on the packed levels (u < 0.5 m/s), W/A = 1 Pa beyond: both lines meet W/A at 0.5 m/s.
+        let cycle = |velocities: &[f64]| -> Vec<CycleLevel> {
+            velocities
+                .iter()
+                .map(|&u| CycleLevel {
+                    velocity_m_per_s: u,
+                    pressure_drop_mean_pa: (2.0 * u).min(1.0),
+                })
+                .collect()
+        };
+        let down_up = cycle_velocities(&cycle(&[1.0, 0.8, 0.3, 0.2, 0.1, 0.0, 0.1, 0.2, 0.3, 0.8, 1.0]), 1.0);
+        let up_down = cycle_velocities(&cycle(&[0.1, 0.2, 0.3, 0.8, 1.0, 0.8, 0.3, 0.2, 0.1, 0.0]), 1.0);
+        for v in [down_up, up_down] {
+            assert!((v.defluidization_m_per_s - 0.5).abs() < 1e-12, "{v:?}");
+            assert!((v.fluidization_theoretical_m_per_s - 0.5).abs() < 1e-12, "{v:?}");
+        }
+        assert_eq!(up_down.peak_level, Some(4), "the climb tops out at 1.0 m/s");
+    }
+
     #[test]
     fn a_cycle_gives_seed_001s_three_velocities() {
         let level = |u: f64, dp: f64| CycleLevel {

@@ -9,6 +9,8 @@
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
+use super::{DrawResult, err};
+
 use super::phase_diagram::{axis_caption, is_geometric, significant, value_label};
 use crate::store::{ParamValue, Pivot};
 use crate::units::{caption, parameter_unit};
@@ -29,12 +31,6 @@ pub(crate) const LINE_COLOURS: [RGBColor; 10] = [
     RGBColor(188, 189, 34),
     RGBColor(23, 190, 207),
 ];
-
-type DrawResult = Result<(), String>;
-
-fn err<E: std::fmt::Display>(e: E) -> String {
-    e.to_string()
-}
 
 /// Where each x value sits on the axis: the number itself, its log10 on a logspace axis, or its index for texts.
 /// Returns the positions and whether the axis is logarithmic, categorical.
@@ -150,15 +146,7 @@ pub fn draw<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, pivot: &Pivot, ti
             }))
             .map_err(err)?;
     }
-    chart
-        .configure_series_labels()
-        .label_font(("sans-serif", 18))
-        .background_style(WHITE.mix(0.85))
-        .border_style(BLACK)
-        .position(SeriesLabelPosition::UpperRight)
-        .draw()
-        .map_err(err)?;
-    Ok(())
+    super::draw_legend(&mut chart, 18, SeriesLabelPosition::UpperRight)
 }
 
 #[cfg(test)]

@@ -4,12 +4,14 @@
 //! - `phase_diagram.rs`: one metric over two swept parameters as a coloured map.
 //! - `curve.rs`: one metric against one parameter, a line per value of a second, replicates' error bars.
 //! - `series.rs`: a series column against time for chosen jobs, with the model their metric was fitted with.
+//! - `fluidization.rs`: the pressure drop against the gas velocity through a job's gas cycle, u_mf marked.
 //!
 //! Every picture is written to a temporary file beside its destination and renamed into place, so a failure leaves
 //! nothing half-written; bad requests (an unknown parameter or metric, a campaign with no finished job that has the
 //! metric, an output path that cannot be written) fail before anything is drawn, with exit code 2.
 
 pub mod curve;
+pub mod fluidization;
 pub mod phase_diagram;
 pub mod series;
 
@@ -20,6 +22,54 @@ use std::sync::Once;
 use plotters::prelude::*;
 
 use crate::error::Error;
+
+/// A drawing's outcome: plotters' errors as their messages.
+pub(crate) type DrawResult = Result<(), String>;
+
+/// A plotters error as its message.
+pub(crate) fn err<E: std::fmt::Display>(e: E) -> String {
+    e.to_string()
+}
+
+/// The chart's legend (the series' labels) at `position`, on a white box with a black border.
+pub(crate) fn draw_legend<'a, DB: DrawingBackend + 'a, CT: plotters::coord::CoordTranslate>(
+    chart: &mut ChartContext<'a, DB, CT>,
+    font_px: u32,
+    position: SeriesLabelPosition,
+) -> DrawResult {
+    chart
+        .configure_series_labels()
+        .label_font(("sans-serif", font_px))
+        .background_style(WHITE.mix(0.85))
+        .border_style(BLACK)
+        .position(position)
+        .draw()
+        .map_err(err)
+}
+
+/// Writes `title` (and `subtitle`, what the drawn jobs share, when not empty) centred at the top of `root`;
+/// returns the area below.
+pub(crate) fn draw_heading<DB: DrawingBackend>(
+    root: &DrawingArea<DB, plotters::coord::Shift>,
+    title: &str,
+    subtitle: &str,
+) -> Result<DrawingArea<DB, plotters::coord::Shift>, String> {
+    let (width, _) = root.dim_in_pixel();
+    let (head, body) = root.split_vertically(if subtitle.is_empty() { 56 } else { 86 });
+    let centred = |size: u32| {
+        TextStyle::from(("sans-serif", size).into_font()).pos(plotters::style::text_anchor::Pos::new(
+            plotters::style::text_anchor::HPos::Center,
+            plotters::style::text_anchor::VPos::Top,
+        ))
+    };
+    head.draw(&Text::new(title, (width as i32 / 2, 14), centred(26)))
+        .map_err(err)?;
+    if !subtitle.is_empty() {
+        head.draw(&Text::new(subtitle, (width as i32 / 2, 52), centred(17)))
+            .map_err(err)?;
+    }
+    Ok(body)
+}
 
 /// The picture formats.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -214,9 +264,9 @@ pub fn curve(
     )
 }
 
-/// `granflow plot <dir> series`: `column` against time for the done jobs matching `filters` (at most
-/// [`series::MAX_JOBS`]), with the fitted model where the column has one. Returns the files written.
-pub fn series(dir: &Path, column: &str, filters: &[String], out: Option<&Path>) -> Result<Vec<PathBuf>, Error> {
+/// The done jobs matching `filters` that a picture of one line per job draws (at most [`series::MAX_JOBS`]), as
+/// their directories, with the campaign, and the stem's filter part; none or too many is a usage error.
+fn chosen_jobs(dir: &Path, filters: &[String]) -> Result<(Vec<PathBuf>, crate::campaign::Campaign), Error> {
     let (jobs, campaign) = crate::inspect::done_jobs_of(dir, filters)?;
     let selection = if filters.is_empty() {
         String::new()
@@ -232,22 +282,40 @@ pub fn series(dir: &Path, column: &str, filters: &[String], out: Option<&Path>) 
     }
     if jobs.len() > series::MAX_JOBS {
         return Err(Error::Usage(format!(
-            "campaign {}: {} finished jobs{selection}; a series picture draws at most {} (narrow it with --where)",
+            "campaign {}: {} finished jobs{selection}; a picture of one line per job draws at most {} (narrow it \
+             with --where)",
             campaign.spec.name,
             jobs.len(),
             series::MAX_JOBS
         )));
     }
-    let mut lines = jobs
-        .iter()
-        .map(|job| series::job_line(&crate::campaign_dir::job_dir(dir, job), &campaign, column))
-        .collect::<Result<Vec<_>, _>>()?;
-    let shared = series::distinguish(&mut lines);
-    let mut stem = format!("series-{}", file_part(column));
+    let dirs = jobs.iter().map(|job| crate::campaign_dir::job_dir(dir, job)).collect();
+    Ok((dirs, campaign))
+}
+
+/// A file name stem: `picture`, then the filters.
+fn stem_with_filters(picture: &str, filters: &[String]) -> String {
+    let mut stem = picture.to_string();
     if !filters.is_empty() {
         stem.push_str(&format!("-{}", file_part(&filters.join("-"))));
     }
-    let outputs = outputs(dir, out, &stem);
+    stem
+}
+
+/// `granflow plot <dir> series`: `column` against time for the done jobs matching `filters` (at most
+/// [`series::MAX_JOBS`]), with the fitted model where the column has one. Returns the files written.
+pub fn series(dir: &Path, column: &str, filters: &[String], out: Option<&Path>) -> Result<Vec<PathBuf>, Error> {
+    let (jobs, campaign) = chosen_jobs(dir, filters)?;
+    let mut lines = jobs
+        .iter()
+        .map(|job_dir| series::job_line(job_dir, &campaign, column))
+        .collect::<Result<Vec<_>, _>>()?;
+    let shared = series::distinguish(&mut lines);
+    let outputs = outputs(
+        dir,
+        out,
+        &stem_with_filters(&format!("series-{}", file_part(column)), filters),
+    );
     check_writable(&outputs)?;
     let title = format!("{column} — {}", campaign.spec.name);
     write_pictures(
@@ -258,18 +326,52 @@ pub fn series(dir: &Path, column: &str, filters: &[String], out: Option<&Path>) 
     )
 }
 
-/// `granflow plot <dir> phase`: `metric` over `x` (columns) and `y` (rows) of the done jobs matching `filters`.
-/// Returns the files written.
+/// `granflow plot <dir> fluidization`: the pressure drop against the gas velocity through the gas cycle of each
+/// done job matching `filters` (at most [`series::MAX_JOBS`]), u_mf marked. Returns the files written.
+pub fn fluidization(dir: &Path, filters: &[String], out: Option<&Path>) -> Result<Vec<PathBuf>, Error> {
+    let (jobs, campaign) = chosen_jobs(dir, filters)?;
+    let mut cycles = jobs
+        .iter()
+        .map(|job_dir| fluidization::job_cycle(job_dir, &campaign))
+        .collect::<Result<Vec<_>, _>>()?;
+    let shared = match cycles.as_slice() {
+        [only] => only.label.clone(),
+        _ => series::distinguish_labels(cycles.iter_mut().map(|c| &mut c.label)),
+    };
+    let outputs = outputs(dir, out, &stem_with_filters("fluidization", filters));
+    check_writable(&outputs)?;
+    let title = format!("fluidization cycle — {}", campaign.spec.name);
+    write_pictures(
+        &outputs,
+        fluidization::SIZE,
+        |root| fluidization::draw(root, &cycles, &title, &shared),
+        |root| fluidization::draw(root, &cycles, &title, &shared),
+    )
+}
+
+/// `granflow plot <dir> phase`: `metric` over `x` (columns) and `y` (rows) of the done jobs matching `filters`, with
+/// the classification `markers` (a second metric of a few distinct values, e.g. wet_phase_mixed) drawn over the
+/// cells. Returns the files written.
 pub fn phase(
     dir: &Path,
     x: &str,
     y: &str,
     metric: &str,
+    markers: Option<&str>,
     filters: &[String],
     out: Option<&Path>,
 ) -> Result<Vec<PathBuf>, Error> {
     let (pivot, campaign) = crate::inspect::pivot_of(dir, x, y, metric, filters)?;
     require_values(&pivot, &campaign, metric, filters, dir)?;
+    let markers = match markers {
+        Some(name) => {
+            let (classes, _) = crate::inspect::pivot_of(dir, x, y, name, filters)?;
+            require_values(&classes, &campaign, name, filters, dir)?;
+            debug_assert!(classes.x_values == pivot.x_values && classes.y_values == pivot.y_values);
+            Some(phase_diagram::Markers::classify(&classes).map_err(Error::Usage)?)
+        }
+        None => None,
+    };
     let stem = format!(
         "phase-{}-{}-{}",
         file_part(metric),
@@ -282,7 +384,7 @@ pub fn phase(
     write_pictures(
         &outputs,
         phase_diagram::SIZE,
-        |root| phase_diagram::draw(root, &pivot, &title),
-        |root| phase_diagram::draw(root, &pivot, &title),
+        |root| phase_diagram::draw(root, &pivot, &title, markers.as_ref()),
+        |root| phase_diagram::draw(root, &pivot, &title, markers.as_ref()),
     )
 }

@@ -11,6 +11,8 @@
 use plotters::coord::Shift;
 use plotters::coord::ranged1d::SegmentValue;
 use plotters::prelude::*;
+
+use super::{DrawResult, err};
 use plotters::style::colors::colormaps::ViridisRGB;
 
 use crate::store::{ParamValue, Pivot};
@@ -98,15 +100,120 @@ fn text_colour(background: &RGBColor) -> RGBColor {
     if luminance > 140.0 { BLACK } else { WHITE }
 }
 
-type DrawResult = Result<(), String>;
+/// Most classes a marker metric may have: one marker shape each.
+pub const MAX_MARKER_CLASSES: usize = 4;
 
-fn err<E: std::fmt::Display>(e: E) -> String {
-    e.to_string()
+/// A classification drawn as markers over the map: a second metric's value in each cell (its mean over the cell's
+/// jobs, to 3 significant digits), one shape per distinct value.
+#[derive(Debug, Clone)]
+pub struct Markers {
+    /// The classes' values in ascending order; a class's index is its shape.
+    pub classes: Vec<f64>,
+    /// `class[row][column]`: the index into `classes` of each cell, like the pivot's cells.
+    pub class: Vec<Vec<Option<usize>>>,
+    /// What each class means, for the legend.
+    pub names: Vec<String>,
 }
 
-/// Draws `pivot` (its metric's values over its two parameters) on `root`, titled `title`.
-pub fn draw<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, pivot: &Pivot, title: &str) -> DrawResult {
+impl Markers {
+    /// The classes of `pivot`'s cells; `Err` (a message) when it has more than [`MAX_MARKER_CLASSES`] values.
+    pub fn classify(pivot: &Pivot) -> Result<Markers, String> {
+        let rounded = |v: f64| significant(v, 3).parse::<f64>().unwrap_or(v);
+        let mut classes: Vec<f64> = pivot
+            .cells
+            .iter()
+            .flatten()
+            .flatten()
+            .map(|c| rounded(c.mean))
+            .filter(|v| v.is_finite())
+            .collect();
+        classes.sort_by(f64::total_cmp);
+        classes.dedup();
+        if classes.len() > MAX_MARKER_CLASSES {
+            return Err(format!(
+                "`{}` has {} distinct values over these cells; markers draw a classification of at most {} \
+                 (e.g. wet_phase_mixed)",
+                pivot.metric,
+                classes.len(),
+                MAX_MARKER_CLASSES
+            ));
+        }
+        let class = pivot
+            .cells
+            .iter()
+            .map(|row| {
+                row.iter()
+                    .map(|c| {
+                        c.as_ref()
+                            .and_then(|c| classes.iter().position(|&v| v == rounded(c.mean)))
+                    })
+                    .collect()
+            })
+            .collect();
+        let names = classes.iter().map(|&v| class_name(&pivot.metric, v)).collect();
+        Ok(Markers { classes, class, names })
+    }
+}
+
+/// The legend's name of a marker class: seed 000's M and S for its phase rule, otherwise `metric = value`.
+fn class_name(metric: &str, value: f64) -> String {
+    match (metric, value) {
+        ("wet_phase_mixed", 1.0) => "M: more mixed than dry (seed 000's rule on Ca_g11, Ca_g22, Ca_g12)".into(),
+        ("wet_phase_mixed", 0.0) => "S: more segregated than dry (the same rule)".into(),
+        ("wet_phase_mixed", v) => format!("replicates disagree (mean {})", significant(v, 3)),
+        (metric, v) => format!("{metric} = {}", significant(v, 3)),
+    }
+}
+
+/// Draws marker shape `class` centred at `at` (backend pixels) with half-size `r`.
+fn draw_marker<DB: DrawingBackend>(area: &DrawingArea<DB, Shift>, class: usize, at: (i32, i32), r: i32) -> DrawResult {
+    let (x, y) = at;
+    let outline = BLACK.stroke_width(2);
+    match class {
+        0 => {
+            area.draw(&Circle::new(at, r, WHITE.filled())).map_err(err)?;
+            area.draw(&Circle::new(at, r, outline)).map_err(err)
+        }
+        1 => {
+            area.draw(&PathElement::new(
+                [(x - r, y - r), (x + r, y + r)],
+                BLACK.stroke_width(3),
+            ))
+            .map_err(err)?;
+            area.draw(&PathElement::new(
+                [(x - r, y + r), (x + r, y - r)],
+                BLACK.stroke_width(3),
+            ))
+            .map_err(err)
+        }
+        2 => {
+            let corners = [(x, y - r), (x + r, y + r), (x - r, y + r)];
+            area.draw(&Polygon::new(corners, WHITE.filled())).map_err(err)?;
+            area.draw(&PathElement::new(
+                [corners[0], corners[1], corners[2], corners[0]],
+                outline,
+            ))
+            .map_err(err)
+        }
+        _ => area
+            .draw(&Rectangle::new([(x - r, y - r), (x + r, y + r)], BLACK.filled()))
+            .map_err(err),
+    }
+}
+
+/// Draws `pivot` (its metric's values over its two parameters) on `root`, titled `title`, with `markers` (a
+/// classification over the same cells) in each cell's upper right corner and their legend under the map.
+pub fn draw<DB: DrawingBackend>(
+    root: &DrawingArea<DB, Shift>,
+    pivot: &Pivot,
+    title: &str,
+    markers: Option<&Markers>,
+) -> DrawResult {
     root.fill(&WHITE).map_err(err)?;
+    let (_, height) = root.dim_in_pixel();
+    let legend_px = markers.map_or(0, |m| 16 + 30 * m.classes.len() as u32);
+    let (root, legend_area) = root.split_vertically(height - legend_px);
+    let root = &root;
     let values: Vec<f64> = pivot.cells.iter().flatten().flatten().map(|c| c.mean).collect();
     let (lo, hi) = values.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), &v| {
         (lo.min(v), hi.max(v))
@@ -173,9 +280,30 @@ pub fn draw<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, pivot: &Pivot, ti
             chart
                 .draw_series(std::iter::once(Text::new(text, centre, style)))
                 .map_err(err)?;
+            if let Some(class) = markers.and_then(|m| m.class.get(row)?.get(column).copied().flatten()) {
+                let (x0, y0) = chart.backend_coord(&(SegmentValue::Exact(column), SegmentValue::Exact(row)));
+                let (x1, y1) = chart.backend_coord(&(SegmentValue::Exact(column + 1), SegmentValue::Exact(row + 1)));
+                let r = ((x1 - x0).abs().min((y1 - y0).abs()) / 10).clamp(4, 11);
+                let at = (x0.max(x1) - 2 * r, y0.min(y1) + 2 * r);
+                draw_marker(root, class, at, r)?;
+            }
         }
     }
-    draw_colour_bar(&bar_area, lo, hi, &caption(&pivot.metric, Some(&pivot.unit)))
+    draw_colour_bar(&bar_area, lo, hi, &caption(&pivot.metric, Some(&pivot.unit)))?;
+    if let Some(markers) = markers {
+        let style = TextStyle::from(("sans-serif", 18).into_font()).pos(plotters::style::text_anchor::Pos::new(
+            plotters::style::text_anchor::HPos::Left,
+            plotters::style::text_anchor::VPos::Center,
+        ));
+        for (k, name) in markers.names.iter().enumerate() {
+            let y = 8 + 15 + 30 * k as i32;
+            draw_marker(&legend_area, k, (150, y), 9)?;
+            legend_area
+                .draw(&Text::new(name.clone(), (170, y), style.clone()))
+                .map_err(err)?;
+        }
+    }
+    Ok(())
 }
 
 /// A vertical bar of the map from `lo` (bottom) to `hi` (top) with its scale and `label`.
@@ -225,6 +353,39 @@ mod tests {
         assert_eq!(significant(1.5e-6, 3), "1.5e-6");
         assert_eq!(significant(2.0, 3), "2");
         assert_eq!(significant(123456.0, 3), "1.23e5");
+    }
+
+    #[test]
+    fn seed_000s_phase_rule_is_drawn_as_m_and_s_and_a_metric_of_many_values_is_refused() {
+        use crate::store::PivotCell;
+        let cell = |mean: f64| {
+            Some(PivotCell {
+                mean,
+                count: 1,
+                std: None,
+            })
+        };
+        let mut pivot = Pivot {
+            x_param: "surface_tension_n_per_m".into(),
+            y_param: "u_m_per_s".into(),
+            metric: "wet_phase_mixed".into(),
+            unit: String::new(),
+            x_values: vec![ParamValue::Real(0.01), ParamValue::Real(0.02)],
+            y_values: vec![ParamValue::Real(1.0), ParamValue::Real(2.0)],
+            cells: vec![vec![cell(1.0), cell(0.0)], vec![None, cell(1.0)]],
+            filters: vec![],
+        };
+        let markers = Markers::classify(&pivot).expect("two classes");
+        assert_eq!(markers.classes, [0.0, 1.0]);
+        assert_eq!(markers.class, [vec![Some(1), Some(0)], vec![None, Some(1)]]);
+        assert!(markers.names[0].starts_with("S: ") && markers.names[1].starts_with("M: "));
+        pivot.metric = "coordination_number".into();
+        pivot.cells = vec![vec![cell(1.0), cell(2.0)], vec![cell(3.0), cell(4.5)]];
+        assert_eq!(Markers::classify(&pivot).expect("four classes").names[3], "coordination_number = 4.5");
+        pivot.cells[1][0] = cell(3.5);
+        pivot.cells.push(vec![cell(5.0), None]);
+        let refused = Markers::classify(&pivot).expect_err("five classes");
+        assert!(refused.contains("has 5 distinct values"), "{refused}");
     }
 
     #[test]

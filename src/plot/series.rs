@@ -16,6 +16,8 @@ use std::path::Path;
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
+use super::{DrawResult, err};
+
 use super::phase_diagram::significant;
 use crate::campaign::Campaign;
 use crate::error::Error;
@@ -96,30 +98,31 @@ pub fn job_line(job_dir: &Path, campaign: &Campaign, column: &str) -> Result<Job
     })
 }
 
-type DrawResult = Result<(), String>;
-
-fn err<E: std::fmt::Display>(e: E) -> String {
-    e.to_string()
-}
-
 /// Shortens the lines' labels (`a=1, b=2`) to the parts that differ between them; returns what they share.
 pub fn distinguish(lines: &mut [JobLine]) -> String {
-    if lines.len() < 2 {
+    distinguish_labels(lines.iter_mut().map(|l| &mut l.label))
+}
+
+/// Shortens job labels (`a=1, b=2`) to the parts that differ between them; returns what they share (nothing for
+/// fewer than two labels, which stay whole).
+pub fn distinguish_labels<'a>(labels: impl Iterator<Item = &'a mut String>) -> String {
+    let mut labels: Vec<&mut String> = labels.collect();
+    if labels.len() < 2 {
         return String::new();
     }
-    let parts: Vec<Vec<String>> = lines
+    let parts: Vec<Vec<String>> = labels
         .iter()
-        .map(|l| l.label.split(", ").map(str::to_string).collect())
+        .map(|l| l.split(", ").map(str::to_string).collect())
         .collect();
     let shared: Vec<String> = parts[0]
         .iter()
         .filter(|p| parts.iter().all(|q| q.contains(p)))
         .cloned()
         .collect();
-    for (line, own) in lines.iter_mut().zip(&parts) {
+    for (label, own) in labels.iter_mut().zip(&parts) {
         let differing: Vec<&str> = own.iter().filter(|p| !shared.contains(p)).map(String::as_str).collect();
         if !differing.is_empty() {
-            line.label = differing.join(", ");
+            **label = differing.join(", ");
         }
     }
     shared.join(", ")
@@ -134,20 +137,7 @@ pub fn draw<DB: DrawingBackend>(
     subtitle: &str,
 ) -> DrawResult {
     root.fill(&WHITE).map_err(err)?;
-    let (width, _) = root.dim_in_pixel();
-    let (head, body) = root.split_vertically(if subtitle.is_empty() { 56 } else { 86 });
-    let centred = |size: u32| {
-        TextStyle::from(("sans-serif", size).into_font()).pos(plotters::style::text_anchor::Pos::new(
-            plotters::style::text_anchor::HPos::Center,
-            plotters::style::text_anchor::VPos::Top,
-        ))
-    };
-    head.draw(&Text::new(title, (width as i32 / 2, 14), centred(26)))
-        .map_err(err)?;
-    if !subtitle.is_empty() {
-        head.draw(&Text::new(subtitle, (width as i32 / 2, 52), centred(17)))
-            .map_err(err)?;
-    }
+    let body = super::draw_heading(root, title, subtitle)?;
     let all = lines
         .iter()
         .flat_map(|l| l.points.iter().chain(l.fit.iter().flat_map(|(_, f)| f)));
@@ -196,13 +186,5 @@ pub fn draw<DB: DrawingBackend>(
                 .legend(move |(x, y)| PathElement::new([(x, y), (x + 30, y)], dark.stroke_width(3)));
         }
     }
-    chart
-        .configure_series_labels()
-        .label_font(("sans-serif", 16))
-        .background_style(WHITE.mix(0.85))
-        .border_style(BLACK)
-        .position(SeriesLabelPosition::UpperRight)
-        .draw()
-        .map_err(err)?;
-    Ok(())
+    super::draw_legend(&mut chart, 16, SeriesLabelPosition::UpperRight)
 }

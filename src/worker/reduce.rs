@@ -441,16 +441,21 @@ fn random_mixture_intensity(job: &JobSpec, sim: &Simulation) -> f64 {
 /// With `analysis.cycle_pressure: first_node` the pressure drop is seed 001's first-node reading and the weight its
 /// W'/A, averaged over the same window (particles cross the node as the bed moves); otherwise the column's pressure
 /// drop against W/A of the whole bed.
-struct LevelStats {
+pub(crate) struct LevelStats {
     /// The level's time window (the second half of its hold), s.
-    window_s: (f64, f64),
-    velocity_m_per_s: f64,
-    pressure_drop_mean_pa: f64,
-    pressure_drop_std_pa: f64,
-    weight_per_area_pa: f64,
+    pub(crate) window_s: (f64, f64),
+    pub(crate) velocity_m_per_s: f64,
+    pub(crate) pressure_drop_mean_pa: f64,
+    pub(crate) pressure_drop_std_pa: f64,
+    pub(crate) weight_per_area_pa: f64,
 }
 
-fn level_stats(job: &JobSpec, built: &BuiltScenario, sim: &Simulation, series: &Series) -> Option<Vec<LevelStats>> {
+pub(crate) fn level_stats(
+    job: &JobSpec,
+    built: &BuiltScenario,
+    sim: &Simulation,
+    series: &Series,
+) -> Option<Vec<LevelStats>> {
     let gas = built.spec.gas.as_ref()?;
     let levels = gas.inflow_levels.as_ref()?;
     let u = inlet_velocity_m_per_s(sim)?;
@@ -491,14 +496,14 @@ fn level_stats(job: &JobSpec, built: &BuiltScenario, sim: &Simulation, series: &
 }
 
 /// Seed 001's cycle velocities and the levels they were read from.
-struct Cycle {
-    velocities: analysis::fluidization::CycleVelocities,
-    levels: Vec<LevelStats>,
+pub(crate) struct Cycle {
+    pub(crate) velocities: analysis::fluidization::CycleVelocities,
+    pub(crate) levels: Vec<LevelStats>,
 }
 
 /// Seed 001's cycle velocities from the level means ([`level_stats`]), each level's pressure drop over its weight
 /// per area (seed 001's ΔP* = ΔP/(W'/A_b)), so that the line meets 1.
-fn cycle(job: &JobSpec, built: &BuiltScenario, sim: &Simulation, series: &Series) -> Option<Cycle> {
+pub(crate) fn cycle(job: &JobSpec, built: &BuiltScenario, sim: &Simulation, series: &Series) -> Option<Cycle> {
     let levels = level_stats(job, built, sim, series)?;
     let points: Vec<analysis::fluidization::CycleLevel> = levels
         .iter()
@@ -592,7 +597,7 @@ fn overshoot_net_force(part: NetForcePart, cycle: Option<&Cycle>, sim: &Simulati
 /// from which the bed keeps moving at every faster level (σ(ΔP) ≥ 1 % of W/A; `minimum_fluidization`'s sustained
 /// reading, applied to the levels of one run instead of to a sweep of runs). NaN when the levels do not bracket the
 /// onset.
-fn stepped_onset_m_per_s(job: &JobSpec, built: &BuiltScenario, sim: &Simulation, series: &Series) -> f64 {
+pub(crate) fn stepped_onset_m_per_s(job: &JobSpec, built: &BuiltScenario, sim: &Simulation, series: &Series) -> f64 {
     let Some(levels) = level_stats(job, built, sim, series) else {
         return f64::NAN;
     };

@@ -25,6 +25,37 @@ pub fn granflow(args: &[&str], cwd: &Path) -> Output {
         .expect("the granflow binary runs")
 }
 
+/// What a granflow run that succeeded printed.
+pub struct Printed {
+    pub stdout: String,
+    pub stderr: String,
+}
+
+/// Runs the granflow binary and fails the test unless it succeeds.
+pub fn granflow_ok(args: &[&str], cwd: &Path) -> Printed {
+    let out = granflow(args, cwd);
+    assert!(
+        out.status.success(),
+        "granflow {args:?} failed: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    Printed {
+        stdout: String::from_utf8_lossy(&out.stdout).into_owned(),
+        stderr: String::from_utf8_lossy(&out.stderr).into_owned(),
+    }
+}
+
+/// Runs the granflow binary and fails the test unless it exits with 2 (bad input) and its stderr holds `message`.
+pub fn granflow_fails_with_2(args: &[&str], cwd: &Path, message: &str) {
+    let out = granflow(args, cwd);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "granflow {args:?}: {stderr}");
+    assert!(
+        stderr.contains(message),
+        "granflow {args:?}: expected `{message}` in: {stderr}"
+    );
+}
+
 /// The newest valid checkpoint's state in a run directory.
 pub fn final_state(dir: &Path) -> granflow::engine::state::SimState {
     granflow::checkpoint::CheckpointSeries::new(dir, 2)
@@ -178,4 +209,24 @@ pub fn wet_drying_kiln() -> String {
     )
     .replace("from_s: 0.02 } }", "from_s: 0.0 } }\n  gas: { lens_conduction: {} }")
         + "drying: { evaporation_coefficient: 1.0 }\n"
+}
+
+/// The number of distinct colours of the 1200 × 900 PNG at `path` (fails on another size).
+pub fn png_colours(path: &Path) -> usize {
+    let decoder = png::Decoder::new(std::fs::File::open(path).unwrap());
+    let mut reader = decoder.read_info().expect("a PNG");
+    let mut pixels = vec![0; reader.output_buffer_size()];
+    let info = reader.next_frame(&mut pixels).expect("its pixels");
+    assert_eq!((info.width, info.height), (1200, 900), "{}", path.display());
+    let stride = info.line_size / info.width as usize;
+    let mut colours = std::collections::HashSet::new();
+    for px in pixels[..info.buffer_size()].chunks(stride) {
+        colours.insert(px.to_vec());
+    }
+    colours.len()
+}
+
+/// Whether the SVG text at `svg` holds `text` as a text element's content (plotters writes each on its own line).
+pub fn svg_has(svg: &str, text: &str) -> bool {
+    svg.lines().any(|l| l.trim() == text)
 }
