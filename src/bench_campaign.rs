@@ -1,6 +1,8 @@
 //! `granflow bench campaign`: the dispatcher's own cost. Runs a campaign of one-step jobs (one particle in a box,
 //! so the simulation itself costs nothing) and reports the wall time per job, process spawn, checkpoints, series,
-//! result and database ingestion included; then times `resume` of the same campaign with every job done.
+//! result and database ingestion included; then times `resume` of the same campaign with every job done. With
+//! `--slurm` the same campaign also runs on the Slurm the environment points to (`executor: slurm`, one array, its
+//! default partition), and both figures are printed side by side.
 
 use std::time::Instant;
 
@@ -12,7 +14,12 @@ use crate::orchestrate::dispatcher::{DispatchOptions, run_campaign};
 pub struct CampaignBenchOptions {
     pub jobs: usize,
     pub max_parallel: usize,
+    /// Also run the campaign on Slurm and compare.
+    pub slurm: bool,
 }
+
+/// The Slurm executor of the comparison: the cluster's defaults, polled twice a second.
+const SLURM_EXECUTOR: &str = "executor: { slurm: { poll_interval_s: 0.5 } }\n";
 
 fn campaign_yaml(jobs: usize) -> String {
     format!(
@@ -37,6 +44,14 @@ metrics: [kinetic_energy_j]
     )
 }
 
+/// CPU seconds this process (the dispatcher, not its workers) has used.
+fn own_cpu_s() -> f64 {
+    nix::sys::resource::getrusage(nix::sys::resource::UsageWho::RUSAGE_SELF).map_or(f64::NAN, |u| {
+        let t = |tv: nix::sys::time::TimeVal| tv.tv_sec() as f64 + 1e-6 * tv.tv_usec() as f64;
+        t(u.user_time()) + t(u.system_time())
+    })
+}
+
 pub fn bench_campaign(opts: &CampaignBenchOptions) -> Result<()> {
     let tmp = tempfile::tempdir().map_err(|e| Error::External(format!("cannot create a temporary directory: {e}")))?;
     let file = tmp.path().join("overhead.yaml");
@@ -49,10 +64,11 @@ pub fn bench_campaign(opts: &CampaignBenchOptions) -> Result<()> {
         force: false,
     };
 
-    let t = Instant::now();
+    let (t, cpu) = (Instant::now(), own_cpu_s());
     let loaded = campaign::load(&file)?;
     let outcome = run_campaign(&loaded, &file, &out, &dispatch)?;
     let run_s = t.elapsed().as_secs_f64();
+    let local_cpu_ms = 1e3 * (own_cpu_s() - cpu) / opts.jobs as f64;
     if outcome.done != opts.jobs {
         let _ = tmp.keep();
         return Err(Error::External(format!(
@@ -83,6 +99,40 @@ pub fn bench_campaign(opts: &CampaignBenchOptions) -> Result<()> {
     }
     println!("resume: {} jobs all done: {:.3} s", opts.jobs, resume_s);
     println!("dispatcher_ms_per_job: {per_job_ms:.2}");
+    println!("dispatcher_cpu_ms_per_job: {local_cpu_ms:.2}");
     println!("resume_all_done_s: {resume_s:.3}");
+    if opts.slurm {
+        let file = tmp.path().join("overhead-slurm.yaml");
+        std::fs::write(&file, campaign_yaml(opts.jobs) + SLURM_EXECUTOR).map_err(|e| Error::io("write", &file, e))?;
+        let out = tmp.path().join("out-slurm");
+        let (t, cpu) = (Instant::now(), own_cpu_s());
+        let loaded = campaign::load(&file)?;
+        let outcome = run_campaign(&loaded, &file, &out, &dispatch)?;
+        let slurm_s = t.elapsed().as_secs_f64();
+        let slurm_cpu_ms = 1e3 * (own_cpu_s() - cpu) / opts.jobs as f64;
+        if outcome.done != opts.jobs {
+            let _ = tmp.keep();
+            return Err(Error::External(format!(
+                "on Slurm only {} of {} jobs finished ({} failed); see {}",
+                outcome.done,
+                opts.jobs,
+                outcome.failed,
+                out.join("campaign.log").display()
+            )));
+        }
+        let slurm_ms = 1e3 * slurm_s / opts.jobs as f64;
+        println!(
+            "slurm: the same {} jobs as one array on the cluster's default partition: {:.2} s, {:.1} ms per job \
+             (submission, Slurm's scheduling and task start, squeue polls every 0.5 s, ingestion)",
+            opts.jobs, slurm_s, slurm_ms
+        );
+        println!("slurm_ms_per_job: {slurm_ms:.2}");
+        println!(
+            "dispatcher CPU per job (its own process, not the workers or Slurm): local {local_cpu_ms:.2} ms, \
+             slurm {slurm_cpu_ms:.2} ms"
+        );
+        println!("slurm_dispatcher_cpu_ms_per_job: {slurm_cpu_ms:.2}");
+        println!("slurm_over_local: {:.2}", slurm_ms / per_job_ms);
+    }
     Ok(())
 }

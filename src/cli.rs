@@ -292,6 +292,9 @@ pub enum BenchCommand {
         jobs: usize,
         #[arg(long, default_value_t = 2)]
         max_parallel: usize,
+        /// Also run the campaign on the Slurm cluster the environment points to (`executor: slurm`) and print both.
+        #[arg(long)]
+        slurm: bool,
     },
 }
 
@@ -378,9 +381,18 @@ pub fn run(cli: Cli) -> Result<i32> {
         })
         .map(|()| 0),
         Command::Bench {
-            which: BenchCommand::Campaign { jobs, max_parallel },
-        } => crate::bench_campaign::bench_campaign(&crate::bench_campaign::CampaignBenchOptions { jobs, max_parallel })
-            .map(|()| 0),
+            which:
+                BenchCommand::Campaign {
+                    jobs,
+                    max_parallel,
+                    slurm,
+                },
+        } => crate::bench_campaign::bench_campaign(&crate::bench_campaign::CampaignBenchOptions {
+            jobs,
+            max_parallel,
+            slurm,
+        })
+        .map(|()| 0),
         Command::Schema => {
             emit(&format!(
                 "{}\n",

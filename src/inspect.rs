@@ -61,14 +61,23 @@ pub fn status(dir: &Path) -> Result<String, Error> {
         let end = jobs_by_id
             .get(r.job_id.as_str())
             .map_or(f64::NAN, |j| j.scenario.time.end_time_s);
+        let slurm = r
+            .slurm_task
+            .as_ref()
+            .map(|task| format!(", Slurm task {task} {}", r.slurm_state.as_deref().unwrap_or("?")))
+            .unwrap_or_default();
         out += &format!(
-            "  running {} ({}): t = {:.4} of {} s, attempt {}{}\n",
+            "  running {} ({}): t = {:.4} of {} s, attempt {}{slurm}{}\n",
             r.job_id,
             label(&r.job_id),
             r.sim_time_s.unwrap_or(0.0),
             end,
             r.attempt,
-            if live { "" } else { " (stale: no dispatcher)" }
+            if live || r.slurm_task.is_some() {
+                ""
+            } else {
+                " (stale: no dispatcher)"
+            }
         );
     }
     for r in rows.iter().filter(|r| r.status == JobStatus::Failed) {
@@ -100,11 +109,20 @@ pub fn status(dir: &Path) -> Result<String, Error> {
             (if fraction.is_finite() { fraction } else { 0.0 }, on_course)
         })
         .collect();
-    let crate::campaign::spec::ExecutorSpec::Local(local) = &campaign.spec.executor;
-    let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
-    let parallel = local
-        .max_parallel
-        .unwrap_or((cores / local.threads_per_job.max(1)).max(1));
+    let parallel = match &campaign.spec.executor {
+        crate::campaign::spec::ExecutorSpec::Local(local) => {
+            let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
+            local
+                .max_parallel
+                .unwrap_or((cores / local.threads_per_job.max(1)).max(1))
+        }
+        // As many at once as Slurm runs now (at least one).
+        crate::campaign::spec::ExecutorSpec::Slurm(_) => rows
+            .iter()
+            .filter(|r| r.slurm_state.as_deref() == Some("RUNNING"))
+            .count()
+            .max(1),
+    };
     if let Some((eta, per_job)) = status_eta(&walls, &running_jobs, pending, parallel) {
         out += &format!(
             "ETA: about {eta:.0} s ({} jobs left, {per_job:.1} s of wall time each{}, {parallel} in parallel)\n",

@@ -698,6 +698,33 @@ const CASES: &[(&str, &str, &str, &[&str])] = &[
         ],
     ),
     (
+        "Slurm task without cpus",
+        "local: { max_parallel: 2 }",
+        "slurm: { cpus_per_task: 0 }",
+        &["key `executor.slurm.cpus_per_task`", "expected at least 1"],
+    ),
+    (
+        "Slurm option granflow sets itself",
+        "local: { max_parallel: 2 }",
+        "slurm: { sbatch_options: [\"--array=0-9\"] }",
+        &[
+            "key `executor.slurm.sbatch_options[0]`",
+            "--array is set by granflow itself",
+        ],
+    ),
+    (
+        "Slurm partition with a space",
+        "local: { max_parallel: 2 }",
+        "slurm: { partition: \"a b\" }",
+        &["key `executor.slurm.partition`", "expected a word without spaces"],
+    ),
+    (
+        "Slurm poll interval of zero",
+        "local: { max_parallel: 2 }",
+        "slurm: { poll_interval_s: 0.0 }",
+        &["key `executor.slurm.poll_interval_s`", "expected 0.1 to 3600 s, got 0"],
+    ),
+    (
         "zero checkpoint.every_steps",
         "every_steps: 1000",
         "every_steps: 0",

@@ -123,28 +123,32 @@ fn expand(
     if spec.checkpoint.keep == 0 {
         return Err(invalid(path, "checkpoint.keep", "expected at least 1 checkpoint kept"));
     }
-    let spec::ExecutorSpec::Local(local) = &spec.executor;
-    if local.threads_per_job == 0 {
-        return Err(invalid(path, "executor.local.threads_per_job", "expected at least 1"));
-    }
-    if local.max_parallel == Some(0) {
-        return Err(invalid(path, "executor.local.max_parallel", "expected at least 1"));
-    }
-    if let Some(t) = local.job_timeout_s
-        && !(t.is_finite() && t > 0.0)
-    {
-        return Err(invalid(
-            path,
-            "executor.local.job_timeout_s",
-            format!("expected a time > 0, got {t}"),
-        ));
-    }
-    if !(local.heartbeat_timeout_s.is_finite() && local.heartbeat_timeout_s > 0.0) {
-        return Err(invalid(
-            path,
-            "executor.local.heartbeat_timeout_s",
-            format!("expected a time > 0, got {}", local.heartbeat_timeout_s),
-        ));
+    match &spec.executor {
+        spec::ExecutorSpec::Local(local) => {
+            if local.threads_per_job == 0 {
+                return Err(invalid(path, "executor.local.threads_per_job", "expected at least 1"));
+            }
+            if local.max_parallel == Some(0) {
+                return Err(invalid(path, "executor.local.max_parallel", "expected at least 1"));
+            }
+            if let Some(t) = local.job_timeout_s
+                && !(t.is_finite() && t > 0.0)
+            {
+                return Err(invalid(
+                    path,
+                    "executor.local.job_timeout_s",
+                    format!("expected a time > 0, got {t}"),
+                ));
+            }
+            if !(local.heartbeat_timeout_s.is_finite() && local.heartbeat_timeout_s > 0.0) {
+                return Err(invalid(
+                    path,
+                    "executor.local.heartbeat_timeout_s",
+                    format!("expected a time > 0, got {}", local.heartbeat_timeout_s),
+                ));
+            }
+        }
+        spec::ExecutorSpec::Slurm(slurm) => check_slurm(slurm).map_err(|(key, m)| invalid(path, key, m))?,
     }
 
     if let Some(v) = &spec.validation {
@@ -245,6 +249,64 @@ fn expand(
         jobs,
         axis_names: names.into_iter().collect(),
     })
+}
+
+/// The Slurm executor's settings that can be judged without asking Slurm (the partition, time limit, account and
+/// QOS are asked of `sbatch --test-only` before anything is submitted). Each text goes to `sbatch` as one argument.
+fn check_slurm(slurm: &spec::SlurmExecutor) -> Result<(), (String, String)> {
+    let key = |k: &str| format!("executor.slurm.{k}");
+    if slurm.cpus_per_task == 0 {
+        return Err((key("cpus_per_task"), "expected at least 1".into()));
+    }
+    if slurm.array_throttle == Some(0) {
+        return Err((key("array_throttle"), "expected at least 1 task at once".into()));
+    }
+    if !(slurm.poll_interval_s.is_finite() && slurm.poll_interval_s >= 0.1 && slurm.poll_interval_s <= 3600.0) {
+        return Err((
+            key("poll_interval_s"),
+            format!("expected 0.1 to 3600 s, got {}", slurm.poll_interval_s),
+        ));
+    }
+    if slurm.signal_before_end_s == 0 || slurm.signal_before_end_s > 65_535 {
+        return Err((
+            key("signal_before_end_s"),
+            format!(
+                "expected 1 to 65535 s (Slurm's limit), got {}",
+                slurm.signal_before_end_s
+            ),
+        ));
+    }
+    let texts = [
+        ("partition", slurm.partition.as_deref()),
+        ("time_limit", slurm.time_limit.as_deref()),
+        ("memory", slurm.memory.as_deref()),
+        ("account", slurm.account.as_deref()),
+        ("qos", slurm.qos.as_deref()),
+    ];
+    for (name, text) in texts {
+        if let Some(t) = text
+            && (t.trim().is_empty() || t.chars().any(char::is_whitespace))
+        {
+            return Err((key(name), format!("expected a word without spaces, got {t:?}")));
+        }
+    }
+    for (k, option) in slurm.sbatch_options.iter().enumerate() {
+        if !option.starts_with('-') || option.contains('\n') {
+            return Err((
+                format!("executor.slurm.sbatch_options[{k}]"),
+                format!("expected one sbatch option starting with `-` (e.g. --constraint=skylake), got {option:?}"),
+            ));
+        }
+        let name = option.split('=').next().unwrap_or(option);
+        const OWN: [&str; 6] = ["--array", "-a", "--output", "-o", "--parsable", "--wrap"];
+        if OWN.contains(&name) {
+            return Err((
+                format!("executor.slurm.sbatch_options[{k}]"),
+                format!("{name} is set by granflow itself"),
+            ));
+        }
+    }
+    Ok(())
 }
 
 /// Refuses a sweep of more than `max_jobs` jobs, counted without expanding it, at the line of its largest axis

@@ -185,6 +185,53 @@ impl Default for AnalysisSpec {
 pub enum ExecutorSpec {
     /// Worker processes on this machine.
     Local(LocalExecutor),
+    /// Job arrays on a Slurm cluster: one array task per job, `granflow worker` on the job's directory (which must
+    /// be on a filesystem the compute nodes share); the dispatcher submits with `sbatch` and follows with `squeue`.
+    Slurm(SlurmExecutor),
+}
+
+/// `executor: slurm: {…}`: what every array task asks Slurm for.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, schemars::JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct SlurmExecutor {
+    /// `--partition` (default: the cluster's default partition).
+    #[serde(default)]
+    pub partition: Option<String>,
+    /// `--time` of each task, in Slurm's forms (`minutes`, `HH:MM:SS`, `D-HH:MM:SS`, …; default: the partition's).
+    /// A task reaching it is warned `signal_before_end_s` before, checkpoints and is requeued.
+    #[serde(default)]
+    pub time_limit: Option<String>,
+    /// `--cpus-per-task`, also the worker's threads.
+    #[serde(default = "one")]
+    pub cpus_per_task: usize,
+    /// `--mem` per task (e.g. `4G`; default: the partition's).
+    #[serde(default)]
+    pub memory: Option<String>,
+    #[serde(default)]
+    pub account: Option<String>,
+    #[serde(default)]
+    pub qos: Option<String>,
+    /// Tasks of one array running at once (`--array=…%N`; default: no limit).
+    #[serde(default)]
+    pub array_throttle: Option<usize>,
+    /// Further `sbatch` options, each one argument (e.g. `--constraint=skylake`).
+    #[serde(default)]
+    pub sbatch_options: Vec<String>,
+    /// Seconds before the time limit (or a preemption) at which Slurm sends the task SIGTERM (`--signal`): the
+    /// worker checkpoints and the task requeues itself.
+    #[serde(default = "default_signal_before_end")]
+    pub signal_before_end_s: u32,
+    /// How often the dispatcher asks `squeue` about its tasks.
+    #[serde(default = "default_poll_interval")]
+    pub poll_interval_s: f64,
+}
+
+fn default_signal_before_end() -> u32 {
+    120
+}
+
+fn default_poll_interval() -> f64 {
+    10.0
 }
 
 impl Default for ExecutorSpec {

@@ -98,6 +98,9 @@ pub fn run_campaign(campaign: &Campaign, source: &Path, out: &Path, opts: &Dispa
     if !opts.force {
         check_no_orphans(campaign, source, out)?;
     }
+    if let ExecutorSpec::Slurm(slurm) = &campaign.spec.executor {
+        super::slurm::check_submission(slurm, out)?;
+    }
 
     std::fs::create_dir_all(campaign_dir::jobs_path(out)).map_err(|e| Error::io("create directory", out, e))?;
     let _lock = campaign_dir::lock(out)?;
@@ -172,7 +175,35 @@ pub fn run_campaign(campaign: &Campaign, source: &Path, out: &Path, opts: &Dispa
         }
     }
 
-    let ExecutorSpec::Local(local) = &campaign.spec.executor;
+    let ExecutorSpec::Local(local) = &campaign.spec.executor else {
+        let ExecutorSpec::Slurm(slurm) = &campaign.spec.executor else {
+            unreachable!("two executors")
+        };
+        let jobs: HashMap<String, JobSpec> = campaign.jobs.iter().map(|j| (j.job_id.clone(), j.clone())).collect();
+        let attempts: HashMap<String, u32> = rows.iter().map(|(id, r)| (id.clone(), r.attempt)).collect();
+        let retries_used = store.retries_used(campaign_id).map_err(store_err)?;
+        let quiet = opts.quiet;
+        let interrupted = super::slurm::dispatch(
+            &mut store,
+            queue,
+            &jobs,
+            attempts,
+            retries_used,
+            &super::slurm::SlurmSettings {
+                spec: slurm,
+                out,
+                campaign: &campaign.spec.name,
+                retry: &campaign.spec.retry,
+                campaign_id,
+            },
+            |event| {
+                if !quiet {
+                    eprintln!("{event}");
+                }
+            },
+        )?;
+        return finish(&mut store, campaign, campaign_id, outcome, interrupted);
+    };
     let threads = opts.threads_per_job.unwrap_or(local.threads_per_job).max(1);
     let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
     let asked_parallel = opts
@@ -218,8 +249,19 @@ pub fn run_campaign(campaign: &Campaign, source: &Path, out: &Path, opts: &Dispa
         progress,
     ))?;
 
+    finish(&mut store, campaign, campaign_id, outcome, interrupted)
+}
+
+/// Stores the derived metrics and counts the jobs by state, after the executor returned.
+fn finish(
+    store: &mut Store,
+    campaign: &Campaign,
+    campaign_id: i64,
+    mut outcome: Outcome,
+    interrupted: bool,
+) -> Result<Outcome, Error> {
     if !campaign.spec.derived.is_empty() {
-        store_derived(&mut store, campaign_id, &campaign.spec.derived)?;
+        store_derived(store, campaign_id, &campaign.spec.derived)?;
     }
     let counts = store.status_counts(campaign_id).map_err(store_err)?;
     let count = |s: JobStatus| counts.get(s.as_str()).copied().unwrap_or(0);
@@ -301,7 +343,7 @@ fn param_value(v: &serde_json::Value) -> ParamValue {
     }
 }
 
-fn ingest(store: &mut Store, job_id: &str, result: &worker::JobResult) -> Result<(), Error> {
+pub(super) fn ingest(store: &mut Store, job_id: &str, result: &worker::JobResult) -> Result<(), Error> {
     store_result(store, job_id, result, store::unix_time_s())?;
     tracing::info!(job = job_id, "result ingested");
     Ok(())
@@ -487,14 +529,7 @@ async fn dispatch(
                         Some(c) => format!("worker exited with code {c} without a result (see {})", worker_log_path(&dir).display()),
                         None => format!("worker was killed by a signal (see {})", worker_log_path(&dir).display()),
                     });
-                    let after = match retry_rule(&settings.retry, class) {
-                        RetryRule::Free => AfterFailure::Retry,
-                        RetryRule::Never => AfterFailure::Final,
-                        RetryRule::Budget(budget) => {
-                            let used = retries_used.entry((job_id.clone(), class)).or_insert(0);
-                            if *used < budget { *used += 1; AfterFailure::Retry } else { AfterFailure::Final }
-                        }
-                    };
+                    let after = after_failure(&settings.retry, &mut retries_used, &job_id, class);
                     store.mark_failed(&job_id, r.attempt, class, &error, store::unix_time_s(), after).map_err(store_err)?;
                     tracing::warn!(job = %job_id, class = class.as_str(), error, retry = matches!(after, AfterFailure::Retry), "attempt ended without a result");
                     match after {
@@ -531,6 +566,29 @@ async fn dispatch(
     }
     progress.finish();
     Ok(interrupts > 0)
+}
+
+/// Whether a job whose attempt ended without a result in `class` runs again, using one of the class's retries
+/// (counted in `retries_used`) where its rule asks for one.
+pub(super) fn after_failure(
+    policy: &RetryPolicy,
+    retries_used: &mut HashMap<(String, FailureClass), u32>,
+    job_id: &str,
+    class: FailureClass,
+) -> AfterFailure {
+    match retry_rule(policy, class) {
+        RetryRule::Free => AfterFailure::Retry,
+        RetryRule::Never => AfterFailure::Final,
+        RetryRule::Budget(budget) => {
+            let used = retries_used.entry((job_id.to_string(), class)).or_insert(0);
+            if *used < budget {
+                *used += 1;
+                AfterFailure::Retry
+            } else {
+                AfterFailure::Final
+            }
+        }
+    }
 }
 
 /// What a failed attempt of a class may do: start again without using a retry, or use one of the class's retries.

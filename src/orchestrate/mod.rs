@@ -1,4 +1,5 @@
-//! Running a campaign: the dispatcher (the only database writer), progress display and the campaign log.
+//! Running a campaign: the dispatcher (the only database writer), its Slurm executor (`slurm.rs`), progress display
+//! and the campaign log.
 //!
 //! What does not live here: the protocol the workers speak (`crate::worker::protocol`), the campaign directory's
 //! layout (`crate::campaign_dir`) and the database (`crate::store`).
@@ -6,3 +7,4 @@
 pub mod dispatcher;
 mod log;
 mod progress;
+pub mod slurm;

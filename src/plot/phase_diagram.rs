@@ -381,7 +381,10 @@ mod tests {
         assert!(markers.names[0].starts_with("S: ") && markers.names[1].starts_with("M: "));
         pivot.metric = "coordination_number".into();
         pivot.cells = vec![vec![cell(1.0), cell(2.0)], vec![cell(3.0), cell(4.5)]];
-        assert_eq!(Markers::classify(&pivot).expect("four classes").names[3], "coordination_number = 4.5");
+        assert_eq!(
+            Markers::classify(&pivot).expect("four classes").names[3],
+            "coordination_number = 4.5"
+        );
         pivot.cells[1][0] = cell(3.5);
         pivot.cells.push(vec![cell(5.0), None]);
         let refused = Markers::classify(&pivot).expect_err("five classes");

@@ -181,4 +181,7 @@ pub struct JobRow {
     pub sim_time_s: Option<f64>,
     pub wall_time_s: Option<f64>,
     pub steps: Option<u64>,
+    /// The Slurm array task of the current or last submission (`<array>_<index>`), and its state as last seen.
+    pub slurm_task: Option<String>,
+    pub slurm_state: Option<String>,
 }

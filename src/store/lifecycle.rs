@@ -102,7 +102,8 @@ impl Store {
         let updated = tx
             .execute(
                 "UPDATE jobs SET status = ?2, attempt = ?3, host = ?4, started_at = ?5, last_heartbeat = ?5,
-                     finished_at = NULL, exit_class = NULL, error = NULL, wall_time_s = NULL
+                     finished_at = NULL, exit_class = NULL, error = NULL, wall_time_s = NULL,
+                     slurm_task = NULL, slurm_state = NULL
                  WHERE job_id = ?1",
                 params![job_id, JobStatus::Running, attempt, host, started_at],
             )
@@ -255,7 +256,8 @@ impl Store {
 
     /// Puts every `running` job of the campaign back to `pending` and closes their open attempts as interrupted;
     /// returns how many jobs were reset. For `resume` after the dispatcher died: the workers it had started are gone
-    /// or will be restarted from their checkpoints.
+    /// or will be restarted from their checkpoints. Jobs submitted to Slurm (with a `slurm_task`) are left: Slurm
+    /// still runs them, and the dispatcher asks it about them.
     pub fn reset_running_to_pending(&mut self, campaign_id: i64) -> Result<usize, StoreError> {
         self.require_campaign(campaign_id)?;
         let path = &self.path;
@@ -266,13 +268,14 @@ impl Store {
             .context(path, &action)?;
         tx.execute(
             "UPDATE attempts SET outcome = 'interrupted'
-             WHERE outcome = 'running' AND job_id IN (SELECT job_id FROM jobs WHERE campaign_id = ?1)",
+             WHERE outcome = 'running' AND job_id IN
+                 (SELECT job_id FROM jobs WHERE campaign_id = ?1 AND slurm_task IS NULL)",
             [campaign_id],
         )
         .context(path, &action)?;
         let reset = tx
             .execute(
-                "UPDATE jobs SET status = ?2 WHERE campaign_id = ?1 AND status = ?3",
+                "UPDATE jobs SET status = ?2 WHERE campaign_id = ?1 AND status = ?3 AND slurm_task IS NULL",
                 params![campaign_id, JobStatus::Pending, JobStatus::Running],
             )
             .context(path, &action)?;

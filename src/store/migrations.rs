@@ -15,6 +15,7 @@ use super::error::{Context, StoreError};
 const MIGRATIONS: &[&str] = &[
     include_str!("../../schemas/results.sql"),
     include_str!("../../schemas/results-2-build.sql"),
+    include_str!("../../schemas/results-3-slurm.sql"),
 ];
 
 /// The schema version this build reads and writes (the number of migrations).

@@ -20,6 +20,7 @@ mod migrations;
 mod pivot;
 mod query;
 mod render;
+mod slurm;
 mod summary;
 #[cfg(test)]
 mod test_support;

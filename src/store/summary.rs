@@ -22,7 +22,7 @@ impl Store {
             .conn
             .prepare_cached(
                 "SELECT job_id, ordinal, params_json, status, attempt, exit_class, error, host, started_at,
-                        finished_at, last_heartbeat, sim_time_s, wall_time_s, steps
+                        finished_at, last_heartbeat, sim_time_s, wall_time_s, steps, slurm_task, slurm_state
                  FROM jobs WHERE campaign_id = ?1 ORDER BY ordinal, job_id",
             )
             .context(&self.path, action)?;
@@ -42,6 +42,8 @@ impl Store {
                 sim_time_s: row.get(11)?,
                 wall_time_s: row.get(12)?,
                 steps: row.get::<_, Option<i64>>(13)?.map(|steps| steps.max(0) as u64),
+                slurm_task: row.get(14)?,
+                slurm_state: row.get(15)?,
             })
         })
         .and_then(|rows| rows.collect())
