@@ -339,6 +339,14 @@ fn tasks_in_queue(cluster: &Cluster) -> Vec<(String, String, String)> {
         .collect()
 }
 
+/// Whether a worker of the job started from a checkpoint (its `started` message in `messages.jsonl`).
+fn resumed_from_checkpoint(job: &Path) -> bool {
+    std::fs::read_to_string(job.join("messages.jsonl"))
+        .unwrap_or_default()
+        .lines()
+        .any(|l| l.contains("\"event\":\"started\"") && !l.contains("\"resumed_from_step\":null"))
+}
+
 /// Checkpoint files in a job directory.
 fn checkpoints(job: &Path) -> usize {
     std::fs::read_dir(job)
@@ -370,6 +378,7 @@ fn slurm_tasks_survive_preemption_a_killed_dispatcher_and_a_drained_node() {
         .unwrap();
     assert!(local.status.success(), "{}", String::from_utf8_lossy(&local.stderr));
 
+    let clock = Instant::now();
     // 1. Preemption: Slurm's warning (SIGTERM to the batch script) to a running task that has checkpointed.
     let mut dispatcher = cluster
         .granflow(&["run", "slurm.yaml", "--out", "preempted", "--quiet"], dir)
@@ -402,15 +411,14 @@ fn slurm_tasks_survive_preemption_a_killed_dispatcher_and_a_drained_node() {
             .iter()
             .any(|(t, state, _)| *t == task && state == "RUNNING")
             .then_some(())
-            .or_else(|| {
-                std::fs::read_to_string(job.join("worker.log"))
-                    .ok()
-                    .filter(|log| log.matches("resum").count() > 0)
-                    .map(|_| ())
-            })
+            .or_else(|| resumed_from_checkpoint(&job).then_some(()))
     });
     let status = dispatcher.wait().unwrap();
     assert!(status.success(), "the dispatcher ends well");
+    assert!(
+        resumed_from_checkpoint(&job),
+        "the requeued task resumed from its checkpoint"
+    );
     assert_same_jobs(&dir.join("preempted"), &dir.join("local"));
     let attempts = sql(
         &cluster,
@@ -432,6 +440,7 @@ fn slurm_tasks_survive_preemption_a_killed_dispatcher_and_a_drained_node() {
         "status,count(*)\ndone,3\n"
     );
 
+    println!("{:.1} s", clock.elapsed().as_secs_f64());
     // 2. The dispatcher killed (-9) while its tasks run; `resume` follows them: nothing submitted twice.
     let mut dispatcher = cluster
         .granflow(&["run", "slurm.yaml", "--out", "killed", "--quiet"], dir)
@@ -468,6 +477,60 @@ fn slurm_tasks_survive_preemption_a_killed_dispatcher_and_a_drained_node() {
     );
     assert_same_jobs(&dir.join("killed"), &dir.join("local"));
 
+    println!("{:.1} s", clock.elapsed().as_secs_f64());
+    // 2b. A worker killed without warning (SIGKILL; its batch script records exit 137): the job is retried under
+    // its `killed` budget, in a new submission, and resumes from its last checkpoint.
+    let mut dispatcher = cluster
+        .granflow(&["run", "slurm.yaml", "--out", "hard", "--quiet"], dir)
+        .stdout(std::process::Stdio::null())
+        .stderr(std::process::Stdio::null())
+        .spawn()
+        .unwrap();
+    let (task, job) = wait_for(120, "a running task with a checkpoint", || {
+        let running = tasks_in_queue(&cluster)
+            .into_iter()
+            .find(|(_, state, _)| state == "RUNNING")?;
+        let list = std::fs::read_to_string(dir.join("hard/slurm/array-0.list")).ok()?;
+        let index: usize = running.0.rsplit('_').next()?.parse().ok()?;
+        let job = PathBuf::from(list.lines().nth(index)?);
+        (checkpoints(&job) >= 2).then_some((running.0, job))
+    });
+    // The worker's pid from its `started` message; SIGKILL as a crashed node or the OOM killer would.
+    let pid = std::fs::read_to_string(job.join("messages.jsonl"))
+        .unwrap()
+        .lines()
+        .filter(|l| l.contains("\"event\":\"started\""))
+        .last()
+        .and_then(|l| serde_json::from_str::<serde_json::Value>(l).ok())
+        .and_then(|m| m["pid"].as_u64())
+        .expect("the worker's started message");
+    let killed = Command::new("kill").args(["-KILL", &pid.to_string()]).status().unwrap();
+    assert!(killed.success());
+    assert!(dispatcher.wait().unwrap().success());
+    assert!(
+        std::fs::read_to_string(job.join("slurm-attempts.jsonl"))
+            .unwrap()
+            .contains(&format!("{{\"task\":\"{task}\",\"exit\":137,")),
+        "the batch script recorded the worker's death by SIGKILL"
+    );
+    let lists = std::fs::read_dir(dir.join("hard/slurm"))
+        .unwrap()
+        .filter(|e| e.as_ref().unwrap().file_name().to_string_lossy().ends_with(".list"))
+        .count();
+    assert_eq!(lists, 2, "the killed job went out again in a second submission");
+    assert_eq!(
+        sql(
+            &cluster,
+            dir,
+            "hard",
+            "SELECT exit_class, count(*) FROM attempts WHERE exit_class IS NOT NULL GROUP BY exit_class"
+        ),
+        "exit_class,count(*)\nkilled,1\n"
+    );
+    assert!(resumed_from_checkpoint(&job), "the retry resumed from a checkpoint");
+    assert_same_jobs(&dir.join("hard"), &dir.join("local"));
+
+    println!("{:.1} s", clock.elapsed().as_secs_f64());
     // 3. A node drained mid-campaign: the running tasks finish, the pending one waits; resumed, it runs.
     let mut dispatcher = cluster
         .granflow(&["run", "slurm.yaml", "--out", "drained", "--quiet"], dir)

@@ -466,7 +466,10 @@ pub fn dispatch(
                 Err(e) => tracing::warn!(job = %f.job.job_id, error = %e, "unreadable result"),
             }
             let last = ends.iter().rev().find(|e| e.task == f.task);
-            let class = last.map_or(FailureClass::Killed, |e| worker::protocol::exit_class(Some(e.exit)));
+            // The shell's 128 + n: the worker was killed by signal n.
+            let class = last.map_or(FailureClass::Killed, |e| {
+                worker::protocol::exit_class((e.exit <= 128).then_some(e.exit))
+            });
             let error = match last {
                 Some(e) => format!(
                     "Slurm task {} ended without a result: the worker exited with {} (see {})",
