@@ -499,8 +499,7 @@ fn slurm_tasks_survive_preemption_a_killed_dispatcher_and_a_drained_node() {
     let pid = std::fs::read_to_string(job.join("messages.jsonl"))
         .unwrap()
         .lines()
-        .filter(|l| l.contains("\"event\":\"started\""))
-        .last()
+        .rfind(|l| l.contains("\"event\":\"started\""))
         .and_then(|l| serde_json::from_str::<serde_json::Value>(l).ok())
         .and_then(|m| m["pid"].as_u64())
         .expect("the worker's started message");
