@@ -15,6 +15,10 @@
 //! requeues its own task (`scontrol requeue`), which starts again from the checkpoint. The dispatcher counts that as
 //! preempted (no retry used). A task killed without warning resumes from its last checkpoint when it is retried.
 //!
+//! A task that leaves the queue without a result and without its script recording an end (killed with its
+//! script, its node lost) is retried by the campaign's retry budgets; where the cluster keeps accounting, `sacct`
+//! names why it ended (TIMEOUT, OUT_OF_MEMORY, NODE_FAIL, …) and sets its failure class.
+//!
 //! The dispatcher may die: tasks keep running. `granflow resume` asks `squeue` for the campaign's tasks (by the job
 //! name `granflow-<hash of the campaign directory>`), follows those still queued or running instead of submitting
 //! them again, ingests results that arrived meanwhile, and retries jobs whose task ended without one. Ctrl-C stops
@@ -255,6 +259,35 @@ fn queued_tasks(job_name: &str) -> Result<HashMap<String, (String, String)>, Err
         .collect())
 }
 
+/// The state Slurm's accounting gives an ended task (`sacct`; `None` where the cluster keeps no accounting or
+/// `sacct` is missing).
+fn accounted_end(task: &str) -> Option<String> {
+    let output = Command::new("sacct")
+        .args(["-n", "-P", "-X", "-j", task, "-o", "State"])
+        .output()
+        .ok()?;
+    if !output.status.success() {
+        return None;
+    }
+    String::from_utf8_lossy(&output.stdout)
+        .lines()
+        .map(str::trim)
+        .find(|l| !l.is_empty())
+        .map(str::to_string)
+}
+
+/// The failure class of a task Slurm ended, by its accounting state (`TIMEOUT`, `OUT_OF_MEMORY`, `NODE_FAIL`,
+/// `CANCELLED by …`, …).
+fn class_of_slurm_state(state: &str) -> FailureClass {
+    match state.split_whitespace().next().unwrap_or("") {
+        "TIMEOUT" | "DEADLINE" => FailureClass::Timeout,
+        "OUT_OF_MEMORY" | "FAILED" => FailureClass::Crash,
+        "NODE_FAIL" | "BOOT_FAIL" => FailureClass::Lost,
+        "PREEMPTED" | "REQUEUED" => FailureClass::Preempted,
+        _ => FailureClass::Killed,
+    }
+}
+
 /// One end of a worker under Slurm, as its batch script recorded it.
 #[derive(Debug, Clone, Deserialize)]
 struct TaskEnd {
@@ -466,10 +499,14 @@ pub fn dispatch(
                 Err(e) => tracing::warn!(job = %f.job.job_id, error = %e, "unreadable result"),
             }
             let last = ends.iter().rev().find(|e| e.task == f.task);
-            // The shell's 128 + n: the worker was killed by signal n.
-            let class = last.map_or(FailureClass::Killed, |e| {
-                worker::protocol::exit_class((e.exit <= 128).then_some(e.exit))
-            });
+            // The shell's 128 + n: the worker was killed by signal n. Without a record, Slurm's accounting (when
+            // the cluster has it) tells why the task ended.
+            let accounted = if last.is_none() { accounted_end(&f.task) } else { None };
+            let class = match (last, &accounted) {
+                (Some(e), _) => worker::protocol::exit_class((e.exit <= 128).then_some(e.exit)),
+                (None, Some(state)) => class_of_slurm_state(state),
+                (None, None) => FailureClass::Killed,
+            };
             let error = match last {
                 Some(e) => format!(
                     "Slurm task {} ended without a result: the worker exited with {} (see {})",
@@ -479,8 +516,12 @@ pub fn dispatch(
                 ),
                 None => format!(
                     "Slurm task {} left the queue without a result and without its batch script recording an \
-                     end (killed, cancelled or its node failed)",
-                    f.task
+                     end ({})",
+                    f.task,
+                    accounted.as_deref().map_or_else(
+                        || "killed, cancelled or its node failed; the cluster keeps no accounting to say which".into(),
+                        |state| format!("sacct: {state}")
+                    )
                 ),
             };
             let after = super::dispatcher::after_failure(settings.retry, &mut retries_used, &f.job.job_id, class);
@@ -496,4 +537,48 @@ pub fn dispatch(
         following = still;
     }
     Ok(stop.load(Ordering::Relaxed))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn slurm_states_map_to_failure_classes() {
+        assert_eq!(class_of_slurm_state("TIMEOUT"), FailureClass::Timeout);
+        assert_eq!(class_of_slurm_state("OUT_OF_MEMORY"), FailureClass::Crash);
+        assert_eq!(class_of_slurm_state("NODE_FAIL"), FailureClass::Lost);
+        assert_eq!(class_of_slurm_state("PREEMPTED"), FailureClass::Preempted);
+        assert_eq!(class_of_slurm_state("CANCELLED by 0"), FailureClass::Killed);
+    }
+
+    #[test]
+    fn each_submission_asks_for_requeue_and_the_warning_signal() {
+        let spec = SlurmExecutor {
+            partition: Some("short".into()),
+            time_limit: Some("1:00:00".into()),
+            cpus_per_task: 4,
+            memory: None,
+            account: Some("granular".into()),
+            qos: None,
+            array_throttle: Some(5),
+            sbatch_options: vec!["--constraint=skylake".into()],
+            signal_before_end_s: 90,
+            poll_interval_s: 10.0,
+        };
+        let args = sbatch_options(&spec, "granflow-0123");
+        for wanted in [
+            "--job-name=granflow-0123",
+            "--cpus-per-task=4",
+            "--requeue",
+            "--signal=B:TERM@90",
+            "--partition=short",
+            "--time=1:00:00",
+            "--account=granular",
+            "--constraint=skylake",
+        ] {
+            assert!(args.iter().any(|a| a == wanted), "{wanted} missing from {args:?}");
+        }
+        assert!(!args.iter().any(|a| a.starts_with("--mem") || a.starts_with("--qos")));
+    }
 }
