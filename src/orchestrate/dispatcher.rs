@@ -204,6 +204,17 @@ pub fn run_campaign(campaign: &Campaign, source: &Path, out: &Path, opts: &Dispa
         )?;
         return finish(&mut store, campaign, campaign_id, outcome, interrupted);
     };
+    // Jobs a Slurm executor submitted are Slurm's until their tasks end: a local run would wait for them forever.
+    let in_slurm = store.slurm_running(campaign_id).map_err(store_err)?;
+    if let Some((job_id, _, task)) = in_slurm.first() {
+        return Err(Error::Usage(format!(
+            "{} job(s) of {} are Slurm tasks still followed as running (e.g. {job_id}, task {task}): resume with the \
+             campaign's executor: slurm, or cancel the tasks (scancel) and run `granflow resume` with executor: slurm \
+             once to record their ends before switching to executor: local",
+            in_slurm.len(),
+            out.display()
+        )));
+    }
     let threads = opts.threads_per_job.unwrap_or(local.threads_per_job).max(1);
     let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
     let asked_parallel = opts
