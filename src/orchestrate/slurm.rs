@@ -43,6 +43,9 @@ use crate::util::write_atomic;
 use crate::worker;
 use crate::worker::protocol::{EXIT_PREEMPTED, Event, Message};
 
+/// `squeue` failures in a row the dispatcher waits through before it stops.
+const SQUEUE_FAILURES_TOLERATED: u32 = 30;
+
 /// Slurm's default `MaxArraySize` is 1001: arrays of at most 1000 tasks are accepted everywhere.
 const MAX_ARRAY_TASKS: usize = 1000;
 
@@ -409,6 +412,7 @@ pub fn dispatch(
 
     let poll = Duration::from_secs_f64(settings.spec.poll_interval_s);
     let mut first = true;
+    let mut squeue_failures = 0;
     loop {
         if !stop.load(Ordering::Relaxed) {
             while !queue.is_empty() {
@@ -446,7 +450,20 @@ pub fn dispatch(
             }
         }
         first = false;
-        let queued = queued_tasks(&job_name)?;
+        // A failed `squeue` (slurmctld restarting, a network hiccup) skips this look; only a run of them stops
+        // the dispatcher (its tasks go on, and `resume` follows them).
+        let queued = match queued_tasks(&job_name) {
+            Ok(queued) => {
+                squeue_failures = 0;
+                queued
+            }
+            Err(e) if squeue_failures + 1 < SQUEUE_FAILURES_TOLERATED => {
+                squeue_failures += 1;
+                tracing::warn!(error = %e, failures = squeue_failures, "squeue failed; asking again at the next poll");
+                continue;
+            }
+            Err(e) => return Err(e),
+        };
         let mut still = Vec::new();
         for mut f in following.drain(..) {
             let dir = job_dir(settings.out, &f.job.job_id);
