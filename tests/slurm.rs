@@ -310,6 +310,13 @@ fn campaigns_run_on_a_real_slurm() {
         "SELECT status, slurm_state, slurm_task IS NOT NULL FROM jobs",
     );
     assert_eq!(tasks.lines().filter(|l| *l == "done,ENDED,1").count(), 3, "{tasks}");
+    // A finished campaign resumes without asking Slurm anything (e.g. its results copied to a laptop).
+    let resumed = cluster
+        .granflow(&["resume", "on-slurm", "--quiet"], dir)
+        .env("PATH", "/nonexistent")
+        .output()
+        .unwrap();
+    assert!(resumed.status.success(), "{}", String::from_utf8_lossy(&resumed.stderr));
 }
 
 /// Polls `what` every 100 ms until it returns `Some`, failing after `limit_s` with `waiting_for` in the message.

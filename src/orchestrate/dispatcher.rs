@@ -98,7 +98,9 @@ pub fn run_campaign(campaign: &Campaign, source: &Path, out: &Path, opts: &Dispa
     if !opts.force {
         check_no_orphans(campaign, source, out)?;
     }
-    if let ExecutorSpec::Slurm(slurm) = &campaign.spec.executor {
+    if let ExecutorSpec::Slurm(slurm) = &campaign.spec.executor
+        && !unfinished.is_empty()
+    {
         super::slurm::check_submission(slurm, out)?;
     }
 

@@ -373,7 +373,11 @@ pub fn dispatch(
         });
     }
     // Tasks submitted by a dispatcher that died before it recorded them: found by their batch script's list.
-    let queued = queued_tasks(&job_name)?;
+    let queued = if queue.is_empty() {
+        HashMap::new()
+    } else {
+        queued_tasks(&job_name)?
+    };
     for (task, (_, script)) in &queued {
         if following.iter().any(|f| &f.task == task) {
             continue;
