@@ -9,7 +9,7 @@ use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
 use std::time::Duration;
 
-use common::granflow;
+use common::{granflow, worker_killed_after};
 use granflow::checkpoint::CheckpointSeries;
 use granflow::engine::state::first_difference;
 use rand::{RngExt, SeedableRng};
@@ -171,21 +171,6 @@ fn a_campaign_runs_stores_every_job_and_pivots() {
         String::from_utf8_lossy(&refused.stderr)
     );
     assert!(String::from_utf8_lossy(&refused.stderr).contains("--force"));
-}
-
-/// Runs `granflow worker <dir>` and kills it with SIGKILL after `delay`, unless it finishes first.
-fn worker_killed_after(dir: &Path, delay: Duration) -> bool {
-    let mut child = Command::new(env!("CARGO_BIN_EXE_granflow"))
-        .args(["worker", dir.to_str().unwrap()])
-        .stdout(Stdio::null())
-        .stderr(Stdio::null())
-        .spawn()
-        .unwrap();
-    std::thread::sleep(delay);
-    let finished = matches!(child.try_wait(), Ok(Some(_)));
-    let _ = child.kill();
-    let _ = child.wait();
-    finished
 }
 
 #[test]

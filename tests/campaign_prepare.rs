@@ -7,10 +7,9 @@
 mod common;
 
 use std::path::Path;
-use std::process::{Command, Stdio};
 use std::time::Duration;
 
-use common::{final_state, granflow};
+use common::{final_state, granflow, worker_killed_after};
 use granflow::engine::state::first_difference;
 use rand::{RngExt, SeedableRng};
 
@@ -154,21 +153,6 @@ fn a_preparation_shared_across_a_parameter_that_acts_before_its_end_fails_its_jo
         assert!(!job.join("result.json").exists());
         assert!(!job.join("series.csv").exists(), "{}", job.display());
     }
-}
-
-/// Runs `granflow worker <dir>` and kills it with SIGKILL after `delay`, unless it finishes first.
-fn worker_killed_after(dir: &Path, delay: Duration) -> bool {
-    let mut child = Command::new(env!("CARGO_BIN_EXE_granflow"))
-        .args(["worker", dir.to_str().unwrap()])
-        .stdout(Stdio::null())
-        .stderr(Stdio::null())
-        .spawn()
-        .unwrap();
-    std::thread::sleep(delay);
-    let finished = matches!(child.try_wait(), Ok(Some(_)));
-    let _ = child.kill();
-    let _ = child.wait();
-    finished
 }
 
 #[test]

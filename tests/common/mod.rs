@@ -230,3 +230,19 @@ pub fn png_colours(path: &Path) -> usize {
 pub fn svg_has(svg: &str, text: &str) -> bool {
     svg.lines().any(|l| l.trim() == text)
 }
+
+/// Runs `granflow worker <dir>` and kills it with SIGKILL after `delay`, unless it finishes first; returns whether
+/// it had finished.
+pub fn worker_killed_after(dir: &Path, delay: std::time::Duration) -> bool {
+    let mut child = std::process::Command::new(env!("CARGO_BIN_EXE_granflow"))
+        .args(["worker", dir.to_str().unwrap()])
+        .stdout(std::process::Stdio::null())
+        .stderr(std::process::Stdio::null())
+        .spawn()
+        .unwrap();
+    std::thread::sleep(delay);
+    let finished = matches!(child.try_wait(), Ok(Some(_)));
+    let _ = child.kill();
+    let _ = child.wait();
+    finished
+}
