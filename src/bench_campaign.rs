@@ -52,6 +52,32 @@ fn own_cpu_s() -> f64 {
     })
 }
 
+/// Runs the campaign `file` into `out` to the end; returns its wall seconds and the dispatcher's own CPU
+/// milliseconds per job. Fails unless every job finished.
+fn timed_run(
+    file: &std::path::Path,
+    out: &std::path::Path,
+    dispatch: &DispatchOptions,
+    jobs: usize,
+    where_: &str,
+) -> Result<(f64, f64)> {
+    let (t, cpu) = (Instant::now(), own_cpu_s());
+    let loaded = campaign::load(file)?;
+    let outcome = run_campaign(&loaded, file, out, dispatch)?;
+    let wall_s = t.elapsed().as_secs_f64();
+    let cpu_ms = 1e3 * (own_cpu_s() - cpu) / jobs as f64;
+    if outcome.done != jobs {
+        return Err(Error::External(format!(
+            "{where_}only {} of {} jobs finished ({} failed); see {}",
+            outcome.done,
+            jobs,
+            outcome.failed,
+            out.join("campaign.log").display()
+        )));
+    }
+    Ok((wall_s, cpu_ms))
+}
+
 pub fn bench_campaign(opts: &CampaignBenchOptions) -> Result<()> {
     let tmp = tempfile::tempdir().map_err(|e| Error::External(format!("cannot create a temporary directory: {e}")))?;
     let file = tmp.path().join("overhead.yaml");
@@ -64,21 +90,14 @@ pub fn bench_campaign(opts: &CampaignBenchOptions) -> Result<()> {
         force: false,
     };
 
-    let (t, cpu) = (Instant::now(), own_cpu_s());
-    let loaded = campaign::load(&file)?;
-    let outcome = run_campaign(&loaded, &file, &out, &dispatch)?;
-    let run_s = t.elapsed().as_secs_f64();
-    let local_cpu_ms = 1e3 * (own_cpu_s() - cpu) / opts.jobs as f64;
-    if outcome.done != opts.jobs {
-        let _ = tmp.keep();
-        return Err(Error::External(format!(
-            "only {} of {} jobs finished ({} failed); see {}",
-            outcome.done,
-            opts.jobs,
-            outcome.failed,
-            out.join("campaign.log").display()
-        )));
-    }
+    // A failed run keeps the temporary directory for its campaign.log.
+    let (run_s, local_cpu_ms) = match timed_run(&file, &out, &dispatch, opts.jobs, "") {
+        Ok(times) => times,
+        Err(e) => {
+            let _ = tmp.keep();
+            return Err(e);
+        }
+    };
     let per_job_ms = 1e3 * run_s / opts.jobs as f64;
     println!(
         "run: {} one-step jobs, {} at a time: {:.2} s, {:.1} ms per job; each job held a worker slot {:.1} ms \
@@ -105,21 +124,13 @@ pub fn bench_campaign(opts: &CampaignBenchOptions) -> Result<()> {
         let file = tmp.path().join("overhead-slurm.yaml");
         std::fs::write(&file, campaign_yaml(opts.jobs) + SLURM_EXECUTOR).map_err(|e| Error::io("write", &file, e))?;
         let out = tmp.path().join("out-slurm");
-        let (t, cpu) = (Instant::now(), own_cpu_s());
-        let loaded = campaign::load(&file)?;
-        let outcome = run_campaign(&loaded, &file, &out, &dispatch)?;
-        let slurm_s = t.elapsed().as_secs_f64();
-        let slurm_cpu_ms = 1e3 * (own_cpu_s() - cpu) / opts.jobs as f64;
-        if outcome.done != opts.jobs {
-            let _ = tmp.keep();
-            return Err(Error::External(format!(
-                "on Slurm only {} of {} jobs finished ({} failed); see {}",
-                outcome.done,
-                opts.jobs,
-                outcome.failed,
-                out.join("campaign.log").display()
-            )));
-        }
+        let (slurm_s, slurm_cpu_ms) = match timed_run(&file, &out, &dispatch, opts.jobs, "on Slurm ") {
+            Ok(times) => times,
+            Err(e) => {
+                let _ = tmp.keep();
+                return Err(e);
+            }
+        };
         let slurm_ms = 1e3 * slurm_s / opts.jobs as f64;
         println!(
             "slurm: the same {} jobs as one array on the cluster's default partition: {:.2} s, {:.1} ms per job \

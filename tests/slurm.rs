@@ -367,6 +367,30 @@ fn checkpoints(job: &Path) -> usize {
         .unwrap_or(0)
 }
 
+/// `granflow run slurm.yaml --out <out>` in `dir` against the cluster, in the background.
+fn spawn_dispatcher(cluster: &Cluster, dir: &Path, out: &str) -> std::process::Child {
+    cluster
+        .granflow(&["run", "slurm.yaml", "--out", out, "--quiet"], dir)
+        .stdout(std::process::Stdio::null())
+        .stderr(std::process::Stdio::null())
+        .spawn()
+        .unwrap()
+}
+
+/// Waits for a running task of the campaign in `dir/<out>` whose job has written at least two checkpoints;
+/// returns the task and its job directory.
+fn running_task_with_checkpoints(cluster: &Cluster, dir: &Path, out: &str) -> (String, PathBuf) {
+    wait_for(120, "a running task with a checkpoint", || {
+        let running = tasks_in_queue(cluster)
+            .into_iter()
+            .find(|(_, state, _)| state == "RUNNING")?;
+        let list = std::fs::read_to_string(dir.join(out).join("slurm/array-0.list")).ok()?;
+        let index: usize = running.0.rsplit('_').next()?.parse().ok()?;
+        let job = PathBuf::from(list.lines().nth(index)?);
+        (checkpoints(&job) >= 2).then_some((running.0, job))
+    })
+}
+
 #[test]
 fn slurm_tasks_survive_preemption_a_killed_dispatcher_and_a_drained_node() {
     let cluster = Cluster::start();
@@ -387,22 +411,8 @@ fn slurm_tasks_survive_preemption_a_killed_dispatcher_and_a_drained_node() {
 
     let clock = Instant::now();
     // 1. Preemption: Slurm's warning (SIGTERM to the batch script) to a running task that has checkpointed.
-    let mut dispatcher = cluster
-        .granflow(&["run", "slurm.yaml", "--out", "preempted", "--quiet"], dir)
-        .stdout(std::process::Stdio::null())
-        .stderr(std::process::Stdio::null())
-        .spawn()
-        .unwrap();
-    let (task, job) = wait_for(120, "a running task with a checkpoint", || {
-        let running = tasks_in_queue(&cluster)
-            .into_iter()
-            .find(|(_, state, _)| state == "RUNNING")?;
-        let jobs = job_dirs(&dir.join("preempted"));
-        let list = std::fs::read_to_string(dir.join("preempted/slurm/array-0.list")).ok()?;
-        let index: usize = running.0.rsplit('_').next()?.parse().ok()?;
-        let job = PathBuf::from(list.lines().nth(index)?);
-        (jobs.iter().any(|j| j.file_name() == job.file_name()) && checkpoints(&job) >= 2).then_some((running.0, job))
-    });
+    let mut dispatcher = spawn_dispatcher(&cluster, dir, "preempted");
+    let (task, job) = running_task_with_checkpoints(&cluster, dir, "preempted");
     let warned = cluster.client("scancel", &["--batch", "--signal=TERM", &task]);
     assert!(warned.status.success(), "{}", String::from_utf8_lossy(&warned.stderr));
     // The task records its end (exit 10: checkpointed on the signal) and requeues itself; Slurm holds a requeued
@@ -449,12 +459,7 @@ fn slurm_tasks_survive_preemption_a_killed_dispatcher_and_a_drained_node() {
 
     println!("{:.1} s", clock.elapsed().as_secs_f64());
     // 2. The dispatcher killed (-9) while its tasks run; `resume` follows them: nothing submitted twice.
-    let mut dispatcher = cluster
-        .granflow(&["run", "slurm.yaml", "--out", "killed", "--quiet"], dir)
-        .stdout(std::process::Stdio::null())
-        .stderr(std::process::Stdio::null())
-        .spawn()
-        .unwrap();
+    let mut dispatcher = spawn_dispatcher(&cluster, dir, "killed");
     wait_for(120, "a running task", || {
         tasks_in_queue(&cluster)
             .iter()
@@ -487,21 +492,8 @@ fn slurm_tasks_survive_preemption_a_killed_dispatcher_and_a_drained_node() {
     println!("{:.1} s", clock.elapsed().as_secs_f64());
     // 2b. A worker killed without warning (SIGKILL; its batch script records exit 137): the job is retried under
     // its `killed` budget, in a new submission, and resumes from its last checkpoint.
-    let mut dispatcher = cluster
-        .granflow(&["run", "slurm.yaml", "--out", "hard", "--quiet"], dir)
-        .stdout(std::process::Stdio::null())
-        .stderr(std::process::Stdio::null())
-        .spawn()
-        .unwrap();
-    let (task, job) = wait_for(120, "a running task with a checkpoint", || {
-        let running = tasks_in_queue(&cluster)
-            .into_iter()
-            .find(|(_, state, _)| state == "RUNNING")?;
-        let list = std::fs::read_to_string(dir.join("hard/slurm/array-0.list")).ok()?;
-        let index: usize = running.0.rsplit('_').next()?.parse().ok()?;
-        let job = PathBuf::from(list.lines().nth(index)?);
-        (checkpoints(&job) >= 2).then_some((running.0, job))
-    });
+    let mut dispatcher = spawn_dispatcher(&cluster, dir, "hard");
+    let (task, job) = running_task_with_checkpoints(&cluster, dir, "hard");
     // The worker's pid from its `started` message; SIGKILL as a crashed node or the OOM killer would.
     let pid = std::fs::read_to_string(job.join("messages.jsonl"))
         .unwrap()
@@ -538,12 +530,7 @@ fn slurm_tasks_survive_preemption_a_killed_dispatcher_and_a_drained_node() {
 
     println!("{:.1} s", clock.elapsed().as_secs_f64());
     // 3. A node drained mid-campaign: the running tasks finish, the pending one waits; resumed, it runs.
-    let mut dispatcher = cluster
-        .granflow(&["run", "slurm.yaml", "--out", "drained", "--quiet"], dir)
-        .stdout(std::process::Stdio::null())
-        .stderr(std::process::Stdio::null())
-        .spawn()
-        .unwrap();
+    let mut dispatcher = spawn_dispatcher(&cluster, dir, "drained");
     wait_for(60, "two running tasks and one pending", || {
         let tasks = tasks_in_queue(&cluster);
         let count = |s: &str| tasks.iter().filter(|(_, state, _)| state == s).count();
