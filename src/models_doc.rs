@@ -61,11 +61,16 @@ contact.rolling (optional, default none):
   constant_directional_torque                                            M = mu_r R* F_n; species.rolling_friction_coefficient
 cohesion (optional, one of):
   liquid_bridge: { surface_tension_n_per_m, viscosity_pa_s?, min_gap_m? }  seed 000 eqs. 2.16-2.20, 6.1-6.44;
-                 { ..., spray?, capillary_force?, walls? }               species.liquid_content, contact_angle_deg;
-                                                                         capillary_force: auto (Mikami for equal
+                 { ..., spray?, capillary_force?, walls?,                species.liquid_content, contact_angle_deg;
+                   bridges_from_s?, bridge_volume?, viscous_radius? }    capillary_force: auto (Mikami for equal
                                                                          beads at θ = 0, else the Young-Laplace
-                                                                         table) or young_laplace; walls default
-                                                                         false (bridges to walls: the sphere-plane
+                                                                         table), young_laplace or
+                                                                         mikami_as_printed (F = 2πRγ F̂(S/2R));
+                                                                         viscous_radius: effective (R*) or
+                                                                         as_printed (2R*); bridge_volume: caps
+                                                                         (eqs 6.1-6.4) or { fixed: V/R³ };
+                                                                         walls default false
+                                                                         (bridges to walls: the sphere-plane
                                                                          Young-Laplace table)
   hamaker: { constant_j, inner_cutoff_m, outer_cutoff_m, walls? }        seed 001 eqs. 6.34-6.37
   square_well: { depth_j, outer_to_inner_radius_ratio, walls? }          seed 001 eqs. 3.6-3.11 as impulses
@@ -324,6 +329,7 @@ mod tests {
         for yaml in [
             "liquid_bridge: { surface_tension_n_per_m: 0.072, viscosity_pa_s: 0.001, min_gap_m: 1.0e-5 }",
             "liquid_bridge: { surface_tension_n_per_m: 0.072, capillary_force: young_laplace, walls: true }",
+            "liquid_bridge: { surface_tension_n_per_m: 0.072, capillary_force: mikami_as_printed, viscous_radius: as_printed, bridge_volume: { fixed: 0.02 } }",
             "hamaker: { constant_j: 1.0e-18, inner_cutoff_m: 4.0e-10, outer_cutoff_m: 1.0e-4, walls: false }",
             "square_well: { depth_j: 1.0e-10, outer_to_inner_radius_ratio: 1.01, walls: true }",
         ] {

@@ -212,6 +212,12 @@ const CASES: &[(&str, &str, &str, &[&str])] = &[
         &["cohesion.square_well.outer_to_inner_radius_ratio", "> 1"],
     ),
     (
+        "a fixed bridge volume beyond Mikami's fit",
+        "time: {",
+        "cohesion: { liquid_bridge: { surface_tension_n_per_m: 0.072, bridge_volume: { fixed: 0.5 } } }\ntime: {",
+        &["cohesion.liquid_bridge.bridge_volume.fixed", "(0, 0.1]"],
+    ),
+    (
         "spray with no liquid",
         "time: {",
         "cohesion: { liquid_bridge: { surface_tension_n_per_m: 0.072, spray: { max_liquid_content: 0.0 } } }\ntime: {",

@@ -271,6 +271,36 @@ fn wet_pair_at_rest(cohesion: &str) -> SimState {
     s
 }
 
+/// `bridge_volume: { fixed: V̂ }` (issue 41's larger bridges): two beads of R = 1 mm meeting form a bridge of
+/// exactly V̂ R³, half from each, and hold at the Hertz–Mikami balance of that bridge; beads holding less than
+/// half of it give all they hold. Liquid on the beads plus the bridge stays what they started with.
+#[test]
+fn a_fixed_volume_bridge_takes_half_its_volume_from_each_bead() {
+    let cohesion =
+        "{ liquid_bridge: { surface_tension_n_per_m: 0.072, viscosity_pa_s: 0.01, bridge_volume: { fixed: 0.03 } } }";
+    let s = wet_pair_at_rest(cohesion);
+    let r3 = 1.0e-9;
+    let volume = s.contacts.cohesion().pairs[0].2.bridge_volume_m3;
+    assert!((volume / (0.03 * r3) - 1.0).abs() < 1e-12, "bridge of {volume} m³");
+    for l in &s.particles.liquid_m3 {
+        assert!((l / (0.005 * r3) - 1.0).abs() < 1e-12, "bead keeps {l} m³");
+    }
+    let d = (s.particles.position_m[0] - s.particles.position_m[1]).norm();
+    let e_star = 1.0e7 / (2.0 * (1.0 - 0.09));
+    let capillary = mikami_force_n(0.0005, volume, 0.0, 0.0, 0.072);
+    let expected = (capillary / (4.0 / 3.0 * e_star * 0.0005f64.sqrt())).powf(2.0 / 3.0);
+    assert!(
+        ((0.002 - d) / expected - 1.0).abs() < 0.01,
+        "overlap {} vs {expected}",
+        0.002 - d
+    );
+    // V̂ = 0.02 per bead, 0.05 asked: each gives its whole 0.02.
+    let s = wet_pair_at_rest(&cohesion.replace("0.03", "0.05"));
+    let volume = s.contacts.cohesion().pairs[0].2.bridge_volume_m3;
+    assert!((volume / (0.04 * r3) - 1.0).abs() < 1e-12, "bridge of {volume} m³");
+    assert!(s.particles.liquid_m3.iter().all(|&l| l == 0.0));
+}
+
 /// Two wet beads brought into contact hold together: a bridge forms on contact, and once the viscous liquid has
 /// damped the motion they rest at the overlap where the Hertz force balances Mikami's capillary force at contact.
 #[test]

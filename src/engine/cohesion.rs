@@ -11,10 +11,13 @@
 
 use super::Vec3;
 use super::models::capillary::{
-    MikamiBridge, lian_rupture_gap_m, viscous_normal_force_n, viscous_tangential_coefficient_n_s_per_m,
+    MikamiBridge, MikamiReading, bridge_volume_on_contact_m3, lian_rupture_gap_m, viscous_normal_force_n,
+    viscous_tangential_coefficient_n_s_per_m,
 };
 use super::models::capillary_table::CapillaryTable;
-use super::models::cohesion_law::{CapillaryForce, CohesionModel, LiquidBridge, square_well_crossing};
+use super::models::cohesion_law::{
+    BridgeVolume, CapillaryForce, CohesionModel, LiquidBridge, ViscousRadius, square_well_crossing,
+};
 use super::models::history::CohesionHistory;
 use super::models::liquid_transfer::rupture_share_of_i;
 use super::particles::{SpeciesId, SpeciesTable};
@@ -143,11 +146,17 @@ impl Cohesion {
                         largest_liquid = largest_liquid.max(spray.max_liquid_content * s.radius_m.powi(3));
                     }
                 }
-                cohesion.range_m = lian_rupture_gap_m(
-                    2.0 * BRIDGE_VOLUME_ALLOWANCE * largest_liquid,
-                    largest_angle,
-                    largest_angle,
-                );
+                let mut largest_bridge = 2.0 * BRIDGE_VOLUME_ALLOWANCE * largest_liquid;
+                if let BridgeVolume::Fixed(v_hat) = b.bridge_volume {
+                    if !(v_hat.is_finite() && v_hat > 0.0 && v_hat <= 0.1) {
+                        return Err((
+                            "cohesion.liquid_bridge.bridge_volume.fixed".into(),
+                            format!("expected a bridge volume V/R³ in (0, 0.1] (Mikami's fit), got {v_hat}"),
+                        ));
+                    }
+                    largest_bridge = largest_bridge.max(v_hat * max_radius_m.powi(3));
+                }
+                cohesion.range_m = lian_rupture_gap_m(largest_bridge, largest_angle, largest_angle);
                 cohesion.wall_range_m = if b.walls { cohesion.range_m } else { 0.0 };
                 let b_law = b.capillary_force;
                 // One table per unordered pair (a ≤ b): j keeps what i does not.
@@ -165,7 +174,12 @@ impl Cohesion {
                         let (ta, tb) = (a.contact_angle_rad, b.contact_angle_rad);
                         // Mikami's fit only where it is settled: equal particles at θ = 0 (B2).
                         let mikami_settled = a.radius_m == b.radius_m && ta == 0.0 && tb == 0.0;
-                        let table = (!mikami_settled || b_law == CapillaryForce::YoungLaplace).then(|| {
+                        let table = match b_law {
+                            CapillaryForce::Auto => !mikami_settled,
+                            CapillaryForce::YoungLaplace => true,
+                            CapillaryForce::MikamiAsPrinted => false,
+                        };
+                        let table = table.then(|| {
                             cohesion.tables.push(capillary_table(a.radius_m, b.radius_m, ta, tb));
                             (cohesion.tables.len() - 1) as u32
                         });
@@ -386,6 +400,8 @@ pub struct Bond {
     pub contact_velocity: Vec3,
     /// The square well's depth relative to a particle pair's: 2 for a wall (seed 001 §6.2.4.2).
     pub depth_factor: f64,
+    /// The partner is a wall.
+    pub wall: bool,
 }
 
 /// What the kernel exerts on i: the normal part along `Bond::normal` (positive pushes i away from the partner) and
@@ -436,7 +452,10 @@ impl Cohesion {
                 let mut normal_n = -capillary;
                 let mut tangential_n = Vec3::zeros();
                 if b.viscosity_pa_s > 0.0 {
-                    let r = bond.effective_radius_m;
+                    let r = match b.viscous_radius {
+                        ViscousRadius::AsPrinted if !bond.wall => 2.0 * bond.effective_radius_m,
+                        _ => bond.effective_radius_m,
+                    };
                     normal_n +=
                         viscous_normal_force_n(r, b.viscosity_pa_s, bond.approach_m_per_s, bond.gap_m, self.min_gap_m);
                     let coefficient = if bond.gap_m <= self.min_gap_m && r == at_contact.effective_radius_m {
@@ -525,6 +544,41 @@ impl Cohesion {
         constants
     }
 
+    /// The liquid particles i and j (films `liquid_*_m3`, radii `radius_*_m`) give a bridge forming between them,
+    /// (from i, from j), m³: their caps (eqs 6.1–6.4) or half a fixed volume each ([`BridgeVolume`]).
+    pub fn pair_bridge_take_m3(
+        &self,
+        liquid_i_m3: f64,
+        radius_i_m: f64,
+        liquid_j_m3: f64,
+        radius_j_m: f64,
+    ) -> (f64, f64) {
+        match self.model {
+            CohesionModel::LiquidBridge(LiquidBridge {
+                bridge_volume: BridgeVolume::Fixed(v_hat),
+                ..
+            }) => {
+                let r = 2.0 * radius_i_m * radius_j_m / (radius_i_m + radius_j_m);
+                let half = 0.5 * v_hat * r * r * r;
+                (half.min(liquid_i_m3), half.min(liquid_j_m3))
+            }
+            _ => bridge_volume_on_contact_m3(liquid_i_m3, radius_i_m, liquid_j_m3, radius_j_m),
+        }
+    }
+
+    /// The liquid a particle (film `liquid_m3`, radius `radius_m`) gives a bridge forming to a wall, m³: half its
+    /// film (eq 6.1 with the wall a sphere of infinite radius: the cap facing a plane is half the particle) or a fixed
+    /// volume.
+    pub fn wall_bridge_take_m3(&self, liquid_m3: f64, radius_m: f64) -> f64 {
+        match self.model {
+            CohesionModel::LiquidBridge(LiquidBridge {
+                bridge_volume: BridgeVolume::Fixed(v_hat),
+                ..
+            }) => (v_hat * radius_m * radius_m * radius_m).min(liquid_m3),
+            _ => 0.5 * liquid_m3,
+        }
+    }
+
     /// The constants of a bridge of `volume_m3` between particle species `a` and `b` (effective radius `r_star_m`).
     pub fn pair_bridge(&self, a: SpeciesId, b: SpeciesId, r_star_m: f64, volume_m3: f64) -> BridgeConstants {
         let CohesionModel::LiquidBridge(bridge) = self.model else {
@@ -533,7 +587,16 @@ impl Cohesion {
         let (ti, tj) = (self.contact_angle_rad[a.index()], self.contact_angle_rad[b.index()]);
         let constants = BridgeConstants {
             volume_m3,
-            mikami: MikamiBridge::new(r_star_m, volume_m3, 0.5 * (ti + tj), bridge.surface_tension_n_per_m),
+            mikami: MikamiBridge::with_reading(
+                r_star_m,
+                volume_m3,
+                0.5 * (ti + tj),
+                bridge.surface_tension_n_per_m,
+                match bridge.capillary_force {
+                    CapillaryForce::MikamiAsPrinted => MikamiReading::AsPrinted,
+                    CapillaryForce::Auto | CapillaryForce::YoungLaplace => MikamiReading::Settled,
+                },
+            ),
             table: self.pair_tables[self.pair_index(a, b)],
             rupture_gap_m: lian_rupture_gap_m(volume_m3, ti, tj).min(self.range_m),
             at_contact: BridgeConstants::NONE.at_contact,
@@ -655,6 +718,7 @@ mod tests {
                 approach_m_per_s,
                 contact_velocity: Vec3::new(0.1, -approach_m_per_s, 0.0),
                 depth_factor: 1.0,
+                wall: false,
             };
             let mut state = CohesionHistory {
                 bridge_volume_m3: 0.0,
@@ -669,5 +733,57 @@ mod tests {
         );
         let cohesion = Cohesion::new(hamaker, &species, &[], 1.35e-3).expect("valid cohesion");
         assert!(!cohesion.inert_without_bridge(0.0));
+    }
+    /// `viscous_radius: as_printed` (seed 000 eqs 2.19–2.20 with R the particle radius) gives four times the
+    /// normal viscous force of the Reynolds reading (R*) between equal particles, and the same against a wall.
+    #[test]
+    fn viscous_forces_as_printed_use_the_particle_radius_between_particles() {
+        use crate::engine::particles::{Species, SpeciesTable};
+        use std::f64::consts::PI;
+        let species = SpeciesTable {
+            species: vec![Species::test_bead("bead", 1.35e-3, 2000.0)],
+        };
+        let force = |reading: &str, wall: bool| {
+            let bridge = CohesionModel::LiquidBridge(
+                serde_norway::from_str(&format!(
+                    "{{ surface_tension_n_per_m: 0.02, viscosity_pa_s: 0.001, viscous_radius: {reading} }}"
+                ))
+                .unwrap(),
+            );
+            let cohesion = Cohesion::new(bridge, &species, &[], 1.35e-3).expect("valid cohesion");
+            let r_star = if wall { 1.35e-3 } else { 0.675e-3 };
+            let volume_m3 = 1e-3 * 1.35e-3f64.powi(3);
+            let constants = cohesion.pair_bridge(SpeciesId(0), SpeciesId(0), r_star, volume_m3);
+            let bond = Bond {
+                normal: Vec3::new(0.0, 1.0, 0.0),
+                gap_m: 5e-5,
+                centre_distance_m: 2.75e-3,
+                well_distance_m: 2.8e-3,
+                effective_radius_m: r_star,
+                effective_mass_kg: 1e-5,
+                approach_m_per_s: 0.2,
+                contact_velocity: Vec3::new(0.1, -0.2, 0.0),
+                depth_factor: if wall { 2.0 } else { 1.0 },
+                wall,
+            };
+            let mut state = CohesionHistory {
+                bridge_volume_m3: volume_m3,
+                in_well: false,
+            };
+            let capillary = cohesion.force(&bond, &mut state, &constants, 1e-5).normal_n;
+            let dry = CohesionModel::LiquidBridge(
+                serde_norway::from_str("{ surface_tension_n_per_m: 0.02, viscosity_pa_s: 0.0 }").unwrap(),
+            );
+            let dry = Cohesion::new(dry, &species, &[], 1.35e-3).expect("valid cohesion");
+            capillary - dry.force(&bond, &mut state, &constants, 1e-5).normal_n
+        };
+        let (effective, printed) = (force("effective", false), force("as_printed", false));
+        let reynolds = 6.0 * PI * 0.001 * 0.675e-3f64.powi(2) * 0.2 / 5e-5;
+        assert!(
+            (effective / reynolds - 1.0).abs() < 1e-12,
+            "{effective} against {reynolds}"
+        );
+        assert!((printed / (4.0 * reynolds) - 1.0).abs() < 1e-12, "{printed}");
+        assert_eq!(force("effective", true), force("as_printed", true));
     }
 }

@@ -20,7 +20,6 @@
 use super::cohesion::{BridgeConstants, Cohesion};
 use super::config::SimConfig;
 use super::contacts::AlignedHistory;
-use super::models::capillary::bridge_volume_on_contact_m3;
 use super::models::cohesion_law::CohesionModel;
 use super::neighbor::NeighborList;
 use super::particles::Particles;
@@ -268,7 +267,7 @@ impl Exchange<'_> {
             return dist2.sqrt() - reach;
         }
         if volume == 0.0 && dist2.sqrt() - reach < 0.0 {
-            let (from_i, from_j) = bridge_volume_on_contact_m3(p.liquid_m3[i], ri, p.liquid_m3[j], rj);
+            let (from_i, from_j) = cohesion.pair_bridge_take_m3(p.liquid_m3[i], ri, p.liquid_m3[j], rj);
             if from_i + from_j >= SMALLEST_BRIDGE * ri.min(rj).powi(3) {
                 p.liquid_m3[i] -= from_i;
                 p.liquid_m3[j] -= from_j;
@@ -322,9 +321,11 @@ impl Exchange<'_> {
         if gap >= cohesion.wall_range_m && volume == 0.0 {
             return if moving { 0.0 } else { gap };
         }
-        if volume == 0.0 && gap < 0.0 && 0.5 * p.liquid_m3[i] >= SMALLEST_BRIDGE * ri.powi(3) {
-            // Eq 6.1 with R_j → ∞: the cap facing a plane is half the particle.
-            let taken = 0.5 * p.liquid_m3[i];
+        if volume == 0.0
+            && gap < 0.0
+            && cohesion.wall_bridge_take_m3(p.liquid_m3[i], ri) >= SMALLEST_BRIDGE * ri.powi(3)
+        {
+            let taken = cohesion.wall_bridge_take_m3(p.liquid_m3[i], ri);
             p.liquid_m3[i] -= taken;
             volume = taken;
             self.events.bridges_formed += 1;

@@ -594,6 +594,7 @@ impl<'a> Context<'a> {
             approach_m_per_s: -u.dot(&normal),
             contact_velocity: u - (bi.w * ri + vel.w(j) * rj).cross(&normal),
             depth_factor: 1.0,
+            wall: false,
         };
         let mut state = cohesion_state(hist, k);
         let bridge = self.bridges.pair.get(slot).unwrap_or(&BridgeConstants::NONE);
@@ -807,6 +808,7 @@ impl<'a> Context<'a> {
             approach_m_per_s: -(vi - prox.wall_velocity).dot(&n),
             contact_velocity: vi - prox.wall_velocity - (wi * ri).cross(&n),
             depth_factor: 2.0,
+            wall: true,
         };
         let bridge = self.bridges.wall.get(slot).unwrap_or(&BridgeConstants::NONE);
         let out = c.force(&bond, &mut state, bridge, self.dt_s);

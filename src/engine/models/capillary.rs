@@ -26,6 +26,15 @@ pub fn mikami_dimensionless_force(volume: f64, gap: f64, contact_angle_rad: f64)
     (a * gap + b).exp() + c
 }
 
+/// How Mikami's fit is scaled (see the module's comment).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum MikamiReading {
+    /// F̂ = F/(πRγ), ĥ = S/R: settled against the exact bridge (VALIDATION B2).
+    Settled,
+    /// F̂ = F/(2πRγ), 2ĥ = S/R, as seed 000 prints it under eq 2.17.
+    AsPrinted,
+}
+
 /// The radius Mikami's fit is written in for a pair of effective radius R*: the equal spheres' R = 2R*.
 fn mikami_radius_m(effective_radius_m: f64) -> f64 {
     2.0 * effective_radius_m
@@ -54,14 +63,36 @@ impl MikamiBridge {
     };
 
     pub fn new(effective_radius_m: f64, volume_m3: f64, contact_angle_rad: f64, surface_tension_n_per_m: f64) -> Self {
+        Self::with_reading(
+            effective_radius_m,
+            volume_m3,
+            contact_angle_rad,
+            surface_tension_n_per_m,
+            MikamiReading::Settled,
+        )
+    }
+
+    /// As [`MikamiBridge::new`] under either reading of the fit's scales.
+    pub fn with_reading(
+        effective_radius_m: f64,
+        volume_m3: f64,
+        contact_angle_rad: f64,
+        surface_tension_n_per_m: f64,
+        reading: MikamiReading,
+    ) -> Self {
         let r = mikami_radius_m(effective_radius_m);
         let volume = volume_m3 / (r * r * r);
         let ln_v = volume.ln();
+        // Settled: F̂ = F/(πRγ), ĥ = S/R. As printed: F̂ = F/(2πRγ), ĥ = S/(2R).
+        let (gap_scale_m, force_scale_n) = match reading {
+            MikamiReading::Settled => (r, PI * r * surface_tension_n_per_m),
+            MikamiReading::AsPrinted => (2.0 * r, 2.0 * PI * r * surface_tension_n_per_m),
+        };
         MikamiBridge {
-            a_per_m: -1.1 * volume.powf(-0.53) / r,
+            a_per_m: -1.1 * volume.powf(-0.53) / gap_scale_m,
             exp_b: ((-0.34 * ln_v - 0.96) * contact_angle_rad * contact_angle_rad - 0.019 * ln_v + 0.48).exp(),
             c: 0.0042 * ln_v + 0.0078,
-            force_scale_n: PI * r * surface_tension_n_per_m,
+            force_scale_n,
         }
     }
 
@@ -148,6 +179,28 @@ pub fn bridge_volume_on_contact_m3(liquid_i_m3: f64, radius_i_m: f64, liquid_j_m
 mod tests {
     use super::*;
     use crate::engine::models::young_laplace::bridge;
+
+    /// Issue 41's reading of Mikami's fit as seed 000 prints it (F̂ = F/(2πRγ), 2ĥ = S/R): at every gap S it is
+    /// 2πRγ F̂(S/(2R)), twice the settled reading's force at half the gap, from the printed formulas directly.
+    #[test]
+    fn mikami_as_printed_is_twice_the_force_over_twice_the_range() {
+        let (r_star, gamma) = (0.675e-3, 0.024);
+        let r = 2.0 * r_star;
+        for v_hat in [1e-3, 1e-2, 5e-2] {
+            let volume_m3 = v_hat * r * r * r;
+            let printed = MikamiBridge::with_reading(r_star, volume_m3, 0.0, gamma, MikamiReading::AsPrinted);
+            let settled = MikamiBridge::new(r_star, volume_m3, 0.0, gamma);
+            for gap_over_r in [0.0, 0.01, 0.05, 0.1] {
+                let gap_m = gap_over_r * r;
+                let direct = 2.0 * PI * r * gamma * mikami_dimensionless_force(v_hat, gap_m / (2.0 * r), 0.0);
+                assert!(
+                    (printed.force_n(gap_m) / direct - 1.0).abs() < 1e-12,
+                    "V̂ {v_hat}, S/R {gap_over_r}"
+                );
+                assert!((printed.force_n(gap_m) / (2.0 * settled.force_n(0.5 * gap_m)) - 1.0).abs() < 1e-12);
+            }
+        }
+    }
 
     /// VALIDATION B1: the force is seed 000's eqs 2.16–2.17 (reference values computed independently from the
     /// printed formulas), in the B2 reading F = πRγ F̂ with R = 2R*.

@@ -50,6 +50,55 @@ pub struct LiquidBridge {
     /// bed can settle dry and be wetted in place: wet and dry runs of one seed then start from the same packing.
     #[serde(default, skip_serializing_if = "is_zero")]
     pub bridges_from_s: f64,
+    /// How much liquid a new bridge takes from its particles (default `caps`, seed 000 eqs 6.1–6.4).
+    #[serde(default, skip_serializing_if = "BridgeVolume::is_caps")]
+    pub bridge_volume: BridgeVolume,
+    /// The radius in the viscous forces (seed 000 eqs 2.19–2.20; default `effective`).
+    #[serde(default, skip_serializing_if = "ViscousRadius::is_effective")]
+    pub viscous_radius: ViscousRadius,
+}
+
+/// How much liquid a bridge takes when it forms. Either way the liquid moves from the particles' films into the
+/// bridge and back on rupture, so the liquid is conserved.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize, schemars::JsonSchema)]
+#[serde(rename_all = "snake_case")]
+pub enum BridgeVolume {
+    /// Each particle gives the liquid on its cap facing the other (seed 000 eqs 6.1–6.4; a wall bridge takes half
+    /// the particle's liquid). With seed 000's V̂ ≤ 0.02 per particle a bridge holds V/R³ ≈ 1e-3. Default.
+    #[default]
+    Caps,
+    /// A bridge of V̂ = V/R³, R = 2R* the pair's equal-sphere radius (R between equal particles), half from each
+    /// particle; to a wall, V̂ R_i³ from the particle. A particle holding less than its share gives all it has, so
+    /// give the particles enough liquid (a bead with n bridges needs V̂ ≥ n V̂_bridge/2). V̂ in (0, 0.1], the range
+    /// of Mikami's fit. Issue 41's "larger bridges" reading (the common fixed-volume bridge of wet DEM studies).
+    Fixed(f64),
+}
+
+impl BridgeVolume {
+    fn is_caps(&self) -> bool {
+        *self == BridgeVolume::Caps
+    }
+}
+
+/// The radius R of the liquid's viscous forces between two particles, F_n = 6πμR² v_n/S and F_t = (8/15 ln(R/S) +
+/// 0.9588) 6πμR v_t (seed 000 eqs 2.19–2.20 with 2h = S the surface gap).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize, schemars::JsonSchema)]
+#[serde(rename_all = "snake_case")]
+pub enum ViscousRadius {
+    /// R* = R_i R_j/(R_i + R_j): Reynolds lubrication between two spheres (R/2 for equal ones), and R_i against a
+    /// wall. Default.
+    #[default]
+    Effective,
+    /// The particle radius as the seed prints it, R = 2R* between particles (four times the normal force of
+    /// `effective` for equal spheres); R_i against a wall, where the printed formula is already Reynolds'. A
+    /// reading to compare against (issue 41).
+    AsPrinted,
+}
+
+impl ViscousRadius {
+    fn is_effective(&self) -> bool {
+        *self == ViscousRadius::Effective
+    }
 }
 
 fn is_zero(v: &f64) -> bool {
@@ -73,6 +122,11 @@ pub enum CapillaryForce {
     Auto,
     /// The Young–Laplace table for every pair.
     YoungLaplace,
+    /// Mikami's fit for every pair, read as seed 000 prints it under eq 2.17: F̂ = F/(2πRγ) and 2ĥ the surface gap
+    /// over R, so F = 2πRγ F̂(S/(2R)) with R = 2R* (twice the settled reading's force, over twice its range; see
+    /// `capillary.rs`). A reading to compare against (issue 41), not the settled law. Bridges to walls keep the
+    /// sphere–plane table.
+    MikamiAsPrinted,
 }
 
 impl CapillaryForce {
