@@ -5,7 +5,9 @@ Reads the job tables of the `granflow report` files (research/d41-*/*-REPORT.md 
 results/validation/d3-wet-umf and d4-mixing-vs-cag reports) and prints, per report, the numbers the D3 and D4
 checks use: D3 the mean stepped u_mf of the dry beds and the wet beds' shifts at Ca_g 1.0 / 1.5 / 2.0; D4 k(γ = 0.08)
 / k(dry) at 2.0 / 2.4 / 2.8 m/s and k(2.8) / k(2.0) at γ = 0.02 and 0.08 (mixing_rate_to_random_per_s). Failed jobs
-are counted and left out (a ratio whose job failed prints as "-").
+are counted and left out, as are beds with no u_mf by the last level (a number they enter prints as "-"). The Hertz
+column is the committed campaign's jobs of the same packings, run by an older engine (its dry beds on packings 1-2:
+1.5000 m/s; today's engine: 1.4375, the dry jobs of d3-bond-as-printed and d3-cag-own-umf).
 
 Run from the repository root:  python3 research/scripts/d41-compare.py
 """
@@ -57,7 +59,9 @@ def d3_numbers(path, seeds):
     for r in rows:
         if r["param.seed"] in seeds:
             case = (float(r["param.liquid_content"]) > 0, float(r["param.surface_tension_n_per_m"]))
-            by_case[case].append(float(r["metric.stepped_fluidization_velocity_m_per_s"]))
+            value = r["metric.stepped_fluidization_velocity_m_per_s"]
+            # Empty: the bed did not fluidize by the last level (1.85 m/s); the mean is then undefined.
+            by_case[case].append(float(value) if value else float("nan"))
     mean = {k: sum(v) / len(v) for k, v in by_case.items()}
     dry = [v for (wet, _), v in mean.items() if not wet][0]
     wet = [mean[k] for k in sorted(k for k in mean if k[0])]
@@ -107,7 +111,7 @@ for path in sorted(glob.glob("research/d41-*/d3-*-REPORT.md")):
     dry, shifts, failed = d3_numbers(path, seeds)
     bdry, bshifts, _ = d3_numbers(D3_BASE, seeds)
     print("| %s | %s | %.4f | %s | %.4f; %s | %d |" % (
-        path, ",".join(seeds), dry, " | ".join("%+.1f %%" % (100 * (s - 1)) for s in shifts), bdry,
+        path, ",".join(seeds), dry, " | ".join(fmt(100 * (s - 1), "+.1f") + " %" for s in shifts), bdry,
         " / ".join("%+.1f %%" % (100 * (s - 1)) for s in bshifts), failed))
 print("\n## D4: k(γ = 0.08)/k(dry) at 2.0 / 2.4 / 2.8 m/s; k(2.8)/k(2.0) at γ = 0.02 / 0.08\n")
 print("| report | packings | wet/dry 2.0 | 2.4 | 2.8 | fast/slow γ 0.02 | γ 0.08 | Hertz, same packings | failed jobs |")
