@@ -742,6 +742,61 @@ const CASES: &[(&str, &str, &str, &[&str])] = &[
         "name: ../x",
         &["key `name`", "expected a name of letters, digits", "got `../x`"],
     ),
+    // Named sets (`named:`, swept as `named.<set>`): the edit adds the section and an axis over it.
+    (
+        "unknown baffle layout name",
+        "sweep:\n  grid:\n",
+        "named:\n  layout:\n    straight: { walls.0.drum.baffles: [ { traditional: { count: 4, length_m: 0.006, half_thickness_m: 0.0006 } } ] }\n    angled: { walls.0.drum.baffles: [ { traditional: { count: 4, length_m: 0.006, half_thickness_m: 0.0006, tilt_deg: 30.0 } } ] }\nsweep:\n  grid:\n    - { param: named.layout, values: [straight, angld] }\n",
+        &[
+            "key `sweep.grid[0].values`",
+            "`angld` is not a member of the named set `layout`",
+            "did you mean `angled`?",
+        ],
+    ),
+    (
+        "unknown named set",
+        "sweep:\n  grid:\n",
+        "named:\n  layout:\n    straight: { walls.0.drum.baffles: [ { traditional: { count: 4, length_m: 0.006, half_thickness_m: 0.0006 } } ] }\nsweep:\n  grid:\n    - { param: named.layuot, values: [straight] }\n",
+        &[
+            "key `sweep.grid[0].param`",
+            "no named set `layuot`",
+            "did you mean `named.layout`?",
+        ],
+    ),
+    (
+        "baffle longer than the drum radius in a named layout",
+        "sweep:\n  grid:\n",
+        "named:\n  layout:\n    none: { walls.0.drum.baffles: [] }\n    long: { walls.0.drum.baffles: [ { traditional: { count: 2, length_m: 0.025, half_thickness_m: 0.0006 } } ] }\nsweep:\n  grid:\n    - { param: named.layout, values: [none, long] }\n",
+        &[
+            "key `base.walls[0].drum.baffles[0].length_m`",
+            "a wall baffle must be shorter than the drum radius 0.02 m",
+            "layout = \"long\"",
+        ],
+    ),
+    (
+        "baffle outside the drum in a named layout",
+        "sweep:\n  grid:\n",
+        "named:\n  layout:\n    none: { walls.0.drum.baffles: [] }\n    outside: { walls.0.drum.baffles: [ { segment: { start_m: [0.0, 0.0], end_m: [0.0, 0.03], half_thickness_m: 0.0006 } } ] }\nsweep:\n  grid:\n    - { param: named.layout, values: [none, outside] }\n",
+        &[
+            "key `base.walls[0].drum.baffles[0]`",
+            "plate 0 reaches 0.03 m from the axis: outside the drum radius 0.02 m",
+        ],
+    ),
+    (
+        "tilted wall baffle leaving the drum",
+        "rotation_rpm: 30.0 }",
+        "rotation_rpm: 30.0, baffles: [ { traditional: { count: 2, length_m: 0.015, half_thickness_m: 0.0006, tilt_deg: 75.0 } } ] }",
+        &["key `base.walls[0].drum.baffles[0]`", "outside the drum radius 0.02 m"],
+    ),
+    (
+        "named member without values",
+        "sweep:\n  grid:\n",
+        "named:\n  layout:\n    none: {}\nsweep:\n  grid:\n    - { param: named.layout, values: [none] }\n",
+        &[
+            "key `named.layout.none`",
+            "expected at least one parameter path and its value",
+        ],
+    ),
 ];
 
 /// Cases whose message rightly names a line other than the edit's: the edit deleted a key, and the message names

@@ -7,6 +7,7 @@
 pub mod derived;
 pub mod job;
 pub mod metrics;
+pub mod named;
 pub mod prepare;
 pub mod spec;
 pub mod sweep;
@@ -48,9 +49,12 @@ impl Campaign {
         }
     }
 
-    /// The name a parameter is stored and queried under.
+    /// The name a parameter is stored and queried under: the axis name, else a named set's name
+    /// (`named.layout` → `layout`), else the path.
     pub fn param_name<'a>(&'a self, path: &'a str) -> &'a str {
-        self.axis_names.get(path).map_or(path, String::as_str)
+        self.axis_names
+            .get(path)
+            .map_or_else(|| named::set_of(path).unwrap_or(path), String::as_str)
     }
 }
 
@@ -112,6 +116,7 @@ fn expand(
 ) -> Result<Campaign, ConfigError> {
     check_finite(yaml).map_err(|(key, m)| invalid(path, key, m))?;
     check_name(&spec.name).map_err(|m| invalid(path, "name", m))?;
+    named::check(&spec.named).map_err(|(key, m)| invalid(path, key, m))?;
     let job_metrics = metrics::check(&spec).map_err(|(key, m)| invalid(path, key, m))?;
     if spec.checkpoint.every_steps == 0 {
         return Err(invalid(
@@ -444,17 +449,29 @@ fn resolve(
     path: &Path,
 ) -> Result<JobSpec, ConfigError> {
     let mut doc = base.clone();
+    // What the scenario receives: the point's parameters, a named set's member in place of its name.
+    let mut assignments =
+        named::assignments(&spec.named, &point, param_keys).map_err(|(key, m)| invalid(path, key, m))?;
     let mut seen_paths: Vec<&str> = Vec::new();
     // Parameters whose last key the base left out (a field at its default): path, key in the campaign file, and
     // the message should the scenario not know the key.
     let mut inserted: Vec<(String, &str, String)> = Vec::new();
-    for (param, value) in &point {
-        let key = param_keys.get(param).map_or("sweep", String::as_str);
+    for named::Assignment {
+        path: param,
+        value,
+        key,
+        via,
+    } in &assignments
+    {
+        let key = key.as_str();
         if seen_paths.contains(&param.as_str()) {
+            let by = via
+                .as_ref()
+                .map_or(String::new(), |v| format!(" (once by the member `{v}` names)"));
             return Err(invalid(
                 path,
                 key,
-                format!("parameter `{param}` is set twice in one point"),
+                format!("parameter `{param}` is set twice in one point{by}"),
             ));
         }
         seen_paths.push(param);
@@ -505,8 +522,18 @@ fn resolve(
             *value = v.clone();
         }
     }
-    if !point.iter().any(|(p, _)| p == "seed") {
-        let seeded: Vec<&(String, serde_json::Value)> = point.iter().filter(|(p, _)| !shared.contains(p)).collect();
+    for a in &mut assignments {
+        if let Some(v) = sweep::get_path(&resolved, &a.path) {
+            a.value = v.clone();
+        }
+    }
+    if !assignments.iter().any(|a| a.path == "seed") {
+        // From the values the scenario receives, so that a named member seeds as its values written out would.
+        let seeded: Vec<(&String, &serde_json::Value)> = assignments
+            .iter()
+            .filter(|a| !shared.contains(&a.path) && a.via.as_ref().is_none_or(|v| !shared.contains(v)))
+            .map(|a| (&a.path, &a.value))
+            .collect();
         let params = serde_json::to_string(&seeded).expect("params serialise");
         let mut bytes = spec.seed.to_le_bytes().to_vec();
         bytes.extend_from_slice(params.as_bytes());
@@ -605,6 +632,17 @@ pub fn validate_jobs<'a>(
     } else {
         format!("{message} (at sweep point {})", describe(&job.params))
     };
+    // The values a named member gave this job are written at the member.
+    let mut param_keys = param_keys;
+    for (param, value) in &job.params {
+        if let (Some(set), Some(name)) = (named::set_of(param), value.as_str())
+            && let Some(member) = campaign.spec.named.get(set).and_then(|m| m.get(name))
+        {
+            for p in member.keys().filter_map(|p| sweep::canonical_path(p).ok()) {
+                param_keys.insert(p, format!("named.{set}.{name}"));
+            }
+        }
+    }
     Err(located(invalid(path, key, message), &campaign.yaml, &param_keys))
 }
 

@@ -14,6 +14,11 @@ pub struct CampaignSpec {
     pub description: String,
     /// The scenario every job starts from (the keys of a scenario file; `name` may be left out).
     pub base: ScenarioSpec,
+    /// Named sets of parameter values (a baffle layout, a material): set → member name → (parameter path →
+    /// value). A sweep takes a set's member names as the values of the parameter `named.<set>`; each job then gets
+    /// the member's values, and stores the name (`campaign::named`).
+    #[serde(default, skip_serializing_if = "std::collections::BTreeMap::is_empty")]
+    pub named: super::named::NamedSets,
     pub sweep: SweepNode,
     /// Per-job reducers by name (`granflow models` lists them); stored as metrics with units.
     // Read as text and checked by `metrics::check`, so that an unknown name is reported at its key with a

@@ -137,13 +137,20 @@ fn expand_node(node: &SweepNode, key: &str, in_zip: bool, max_points: usize) -> 
     }
 }
 
-/// The names given to axes (`name:` next to `param:`), as (canonical path, name).
+/// The names given to axes (`name:` next to `param:`; an axis over a named set's members is named after the set
+/// unless it says otherwise), as (canonical path, name).
 pub fn axis_names(node: &SweepNode) -> Vec<(String, String)> {
     let mut out = Vec::new();
-    if let (Some(p), Some(n)) = (&node.param, &node.name)
+    if let Some(p) = &node.param
         && let Ok(p) = canonical_path(p)
     {
-        out.push((p, n.clone()));
+        let name = node
+            .name
+            .clone()
+            .or_else(|| super::named::set_of(&p).map(str::to_string));
+        if let Some(n) = name {
+            out.push((p, n));
+        }
     }
     for child in node.grid.iter().chain(&node.zip).flatten() {
         out.extend(axis_names(child));

@@ -646,6 +646,17 @@ fn build_walls(
                 for (b, baffle) in d.baffles.iter().enumerate() {
                     let bkey = |f: &str| format!("walls[{k}].drum.baffles[{b}].{f}");
                     for (s, (start, end), half) in baffle_segments(c, baffle, d.radius_m, &bkey)? {
+                        // A plate must stay inside the drum (a wall baffle's foot sits on the wall itself).
+                        let farthest_m = start[0].hypot(start[1]).max(end[0].hypot(end[1]));
+                        if farthest_m.is_nan() || farthest_m > d.radius_m * (1.0 + 1e-9) {
+                            return Err(c.fail(
+                                format!("walls[{k}].drum.baffles[{b}]"),
+                                format!(
+                                    "plate {s} reaches {farthest_m} m from the axis: outside the drum radius {} m",
+                                    d.radius_m
+                                ),
+                            ));
+                        }
                         walls.push(Wall {
                             name: format!("{}_baffle_{b}_{s}", d.name),
                             species: id,
