@@ -110,6 +110,9 @@ pub fn status(dir: &Path) -> Result<String, Error> {
         })
         .collect();
     let parallel = match &campaign.spec.executor {
+        // A live dispatcher runs as many at once as it was told (`--max-parallel` may override the file) and the
+        // memory budget allows: the jobs running now, while some are still pending.
+        crate::campaign::spec::ExecutorSpec::Local(_) if live && running > 0 && pending > 0 => running,
         crate::campaign::spec::ExecutorSpec::Local(local) => {
             let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
             local

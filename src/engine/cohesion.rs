@@ -356,8 +356,9 @@ pub struct BridgeConstants {
 /// at its floor (so the kernel's result is the same to the bit with or without them).
 #[derive(Debug, Clone, Copy)]
 pub struct BridgeAtContact {
-    /// The effective radius they were computed for (NaN: none), m.
-    pub effective_radius_m: f64,
+    /// The radius the viscous coefficient was computed for (NaN: none): R*, or 2R* between particles with
+    /// `viscous_radius: as_printed` ([`ViscousRadius`]), m.
+    pub viscous_radius_m: f64,
     /// The capillary force at a gap ≤ 0 (the force laws hold the gap at 0), N.
     pub capillary_n: f64,
     /// The viscous tangential coefficient at a gap ≤ `Cohesion::min_gap_m` (held at it), N s/m.
@@ -371,7 +372,7 @@ impl BridgeConstants {
         table: None,
         rupture_gap_m: 0.0,
         at_contact: BridgeAtContact {
-            effective_radius_m: f64::NAN,
+            viscous_radius_m: f64::NAN,
             capillary_n: 0.0,
             viscous_tangential_n_s_per_m: 0.0,
         },
@@ -458,7 +459,7 @@ impl Cohesion {
                     };
                     normal_n +=
                         viscous_normal_force_n(r, b.viscosity_pa_s, bond.approach_m_per_s, bond.gap_m, self.min_gap_m);
-                    let coefficient = if bond.gap_m <= self.min_gap_m && r == at_contact.effective_radius_m {
+                    let coefficient = if bond.gap_m <= self.min_gap_m && r == at_contact.viscous_radius_m {
                         at_contact.viscous_tangential_n_s_per_m
                     } else {
                         viscous_tangential_coefficient_n_s_per_m(r, b.viscosity_pa_s, bond.gap_m, self.min_gap_m)
@@ -524,18 +525,19 @@ impl Cohesion {
         }
     }
 
-    /// `constants` completed with its forces at contact ([`BridgeAtContact`]) for effective radius `r_star_m`.
+    /// `constants` completed with its forces at contact ([`BridgeAtContact`]), the viscous ones for radius
+    /// `viscous_radius_m` (the one [`Self::force`] uses for this bond).
     fn with_contact_forces(
         &self,
         mut constants: BridgeConstants,
-        r_star_m: f64,
+        viscous_radius_m: f64,
         bridge: LiquidBridge,
     ) -> BridgeConstants {
         constants.at_contact = BridgeAtContact {
-            effective_radius_m: r_star_m,
+            viscous_radius_m,
             capillary_n: self.capillary_force_n(&constants, constants.volume_m3, 0.0, bridge.surface_tension_n_per_m),
             viscous_tangential_n_s_per_m: viscous_tangential_coefficient_n_s_per_m(
-                r_star_m,
+                viscous_radius_m,
                 bridge.viscosity_pa_s,
                 self.min_gap_m,
                 self.min_gap_m,
@@ -601,7 +603,11 @@ impl Cohesion {
             rupture_gap_m: lian_rupture_gap_m(volume_m3, ti, tj).min(self.range_m),
             at_contact: BridgeConstants::NONE.at_contact,
         };
-        self.with_contact_forces(constants, r_star_m, bridge)
+        let viscous_radius_m = match bridge.viscous_radius {
+            ViscousRadius::AsPrinted => 2.0 * r_star_m,
+            ViscousRadius::Effective => r_star_m,
+        };
+        self.with_contact_forces(constants, viscous_radius_m, bridge)
     }
 
     /// The constants of a bridge of `volume_m3` between a particle of species `a` and radius `radius_m` and a wall of
@@ -785,5 +791,51 @@ mod tests {
         );
         assert!((printed / (4.0 * reynolds) - 1.0).abs() < 1e-12, "{printed}");
         assert_eq!(force("effective", true), force("as_printed", true));
+    }
+
+    #[test]
+    fn the_touching_bridge_cache_holds_the_viscous_radius_each_reading_uses() {
+        use crate::engine::particles::{Species, SpeciesTable};
+        let species = SpeciesTable {
+            species: vec![Species::test_bead("bead", 1.35e-3, 2000.0)],
+        };
+        for (reading, radius_factor) in [("effective", 1.0), ("as_printed", 2.0)] {
+            let bridge = CohesionModel::LiquidBridge(
+                serde_norway::from_str(&format!(
+                    "{{ surface_tension_n_per_m: 0.02, viscosity_pa_s: 0.001, viscous_radius: {reading} }}"
+                ))
+                .unwrap(),
+            );
+            let cohesion = Cohesion::new(bridge, &species, &[], 1.35e-3).expect("valid cohesion");
+            let (r_star, volume_m3) = (0.675e-3, 1e-3 * 1.35e-3f64.powi(3));
+            let cached = cohesion.pair_bridge(SpeciesId(0), SpeciesId(0), r_star, volume_m3);
+            assert_eq!(cached.at_contact.viscous_radius_m, radius_factor * r_star, "{reading}");
+            // The same bridge without the cache: the kernel computes the coefficient itself.
+            let mut uncached = cached;
+            uncached.at_contact.viscous_radius_m = f64::NAN;
+            let bond = Bond {
+                normal: Vec3::new(0.0, 1.0, 0.0),
+                gap_m: -2e-6,
+                centre_distance_m: 2.698e-3,
+                well_distance_m: 2.8e-3,
+                effective_radius_m: r_star,
+                effective_mass_kg: 1e-5,
+                approach_m_per_s: 0.2,
+                contact_velocity: Vec3::new(0.1, -0.2, 0.05),
+                depth_factor: 1.0,
+                wall: false,
+            };
+            let mut state = CohesionHistory {
+                bridge_volume_m3: volume_m3,
+                in_well: false,
+            };
+            let with_cache = cohesion.force(&bond, &mut state, &cached, 1e-5);
+            let without = cohesion.force(&bond, &mut state, &uncached, 1e-5);
+            assert!(with_cache.tangential_n.norm() > 0.0);
+            assert_eq!(
+                with_cache, without,
+                "{reading}: the cache must give the kernel's own bits"
+            );
+        }
     }
 }

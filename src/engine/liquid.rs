@@ -321,14 +321,13 @@ impl Exchange<'_> {
         if gap >= cohesion.wall_range_m && volume == 0.0 {
             return if moving { 0.0 } else { gap };
         }
-        if volume == 0.0
-            && gap < 0.0
-            && cohesion.wall_bridge_take_m3(p.liquid_m3[i], ri) >= SMALLEST_BRIDGE * ri.powi(3)
-        {
+        if volume == 0.0 && gap < 0.0 {
             let taken = cohesion.wall_bridge_take_m3(p.liquid_m3[i], ri);
-            p.liquid_m3[i] -= taken;
-            volume = taken;
-            self.events.bridges_formed += 1;
+            if taken >= SMALLEST_BRIDGE * ri.powi(3) {
+                p.liquid_m3[i] -= taken;
+                volume = taken;
+                self.events.bridges_formed += 1;
+            }
         }
         let constants = &mut self.wall_cache[k];
         if volume > 0.0 && constants.volume_m3 != volume {
