@@ -250,6 +250,22 @@ const CASES: &[(&str, &str, &str, &[&str])] = &[
         &["gravity.vector_m_per_s2", "more than the smallest particle radius"],
     ),
     (
+        "gravity flip frequency of zero (the zig-zag chute)",
+        "vector_m_per_s2: [0.0, 0.0, -9.81]",
+        "vector_m_per_s2: [0.0, 0.0, -9.81], flip: { axis: x, frequency_hz: 0.0 }",
+        &[
+            "bad.yaml:4:",
+            "gravity.flip.frequency_hz",
+            "expected a finite value > 0, got 0",
+        ],
+    ),
+    (
+        "negative gravity flip frequency",
+        "vector_m_per_s2: [0.0, 0.0, -9.81]",
+        "vector_m_per_s2: [0.0, 0.0, -9.81], flip: { axis: x, frequency_hz: -2.0 }",
+        &["bad.yaml:4:", "gravity.flip.frequency_hz"],
+    ),
+    (
         "a gas inflow of 1e5 m/s",
         "time: {",
         "gas: { density_kg_per_m3: 1.2, viscosity_pa_s: 1.8e-5, cells: [4, 4, 10], dem_steps_per_gas_step: 10, sides: { z_low: { inlet: { superficial_velocity_m_per_s: 1.0e5 } }, z_high: outlet } }\ntime: {",

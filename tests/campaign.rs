@@ -40,7 +40,7 @@ sweep:
     - zip:
         - {{ param: fill.0.lattice.hi_m.1, name: fill_top_m, values: [-0.006, 0.0] }}
         - {{ param: fill.1.lattice.hi_m.1, values: [-0.006, 0.0] }}
-metrics: [lacey_index, intensity_of_segregation, kinetic_energy_j, coordination_number]
+metrics: [lacey_index, intensity_of_segregation, kinetic_energy_j, coordination_number, height_mixing_index]
 analysis: {{ mixing_species: red }}
 executor: {{ local: {{ max_parallel: 2 }} }}
 checkpoint: {{ every_steps: 1000, keep: 2 }}
@@ -85,7 +85,7 @@ fn a_campaign_runs_stores_every_job_and_pivots() {
     let counts = sql(&out, "SELECT status, COUNT(*) FROM jobs GROUP BY status");
     assert!(counts.contains("done,4"), "{counts}");
     let metrics = sql(&out, "SELECT COUNT(*) FROM metrics WHERE value IS NOT NULL");
-    assert!(metrics.contains("16"), "4 jobs × 4 metrics: {metrics}");
+    assert!(metrics.contains("20"), "4 jobs × 5 metrics: {metrics}");
     for id in sql(&out, "SELECT job_id FROM jobs").lines().skip(1) {
         let dir = out.join("jobs").join(id.trim());
         assert!(
@@ -279,7 +279,7 @@ fn killing_the_dispatcher_loses_nothing_and_resume_finishes() {
     ok(&["resume", out.to_str().unwrap(), "--quiet"], tmp.path());
     assert!(sql(&out, "SELECT COUNT(*) FROM jobs WHERE status = 'done'").contains('4'));
     assert!(
-        sql(&out, "SELECT COUNT(*) FROM metrics").contains("16"),
+        sql(&out, "SELECT COUNT(*) FROM metrics").contains("20"),
         "no metric lost or duplicated"
     );
     assert!(sql(&out, "PRAGMA integrity_check").contains("ok"));
@@ -432,7 +432,7 @@ fn reducing_a_finished_campaign_again_recomputes_its_metrics_bit_for_bit() {
     let metrics_sql = "SELECT job_id, name, hex(value) FROM metrics ORDER BY job_id, name";
     let before = sql(&out, metrics_sql);
     let finished = sql(&out, "SELECT job_id, finished_at FROM jobs ORDER BY job_id");
-    assert_eq!(before.lines().count(), 1 + 16, "{before}");
+    assert_eq!(before.lines().count(), 1 + 20, "{before}");
 
     let db = rusqlite::Connection::open(out.join("campaign.sqlite")).unwrap();
     db.execute("UPDATE metrics SET value = -1.0", []).unwrap();

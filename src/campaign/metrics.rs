@@ -84,6 +84,8 @@ job_metrics! {
         "k of IS(t) = IS_R + b exp(-k t) with IS_R = sqrt(P(1-P)/n) the random mixture's IS (n particles per local sample): the approach to a random mixture";
     TimeTo90PctMaxLacey => "time_to_90pct_max_lacey_s", "s", [MixingSpecies],
         "first time the Lacey index reaches 90 % of its maximum (seed 000 Table 1)";
+    HeightMixingIndex => "height_mixing_index", "1", [],
+        "seed 001's mixing index (§7.2.2) at the last series row: mean height of the particles that were at or above the bed's median height at analysis.height_families_at_s over that of the rest, heights from the domain's floor along -gravity; 3 segregated, 1 mixed (also a series column)";
     MeanHeightTimeAverage => "mean_height_time_avg_m", "m", [],
         "mean particle centre height along -gravity, averaged over the series from analysis.average_from_s (seed 002's mean particle height, 5-10 s)";
     CoordinationNumberTimeAverage => "coordination_number_time_avg", "1", [],
@@ -398,6 +400,17 @@ pub fn check(spec: &CampaignSpec) -> Result<Vec<JobMetric>, (String, String)> {
     {
         return Err((
             "analysis.heating_fit_from_s".into(),
+            format!(
+                "expected 0 <= value < the end time ({} s), got {t}",
+                spec.base.time.end_time_s
+            ),
+        ));
+    }
+    if let Some(t) = spec.analysis.height_families_at_s
+        && !(t.is_finite() && t >= 0.0 && t < spec.base.time.end_time_s)
+    {
+        return Err((
+            "analysis.height_families_at_s".into(),
             format!(
                 "expected 0 <= value < the end time ({} s), got {t}",
                 spec.base.time.end_time_s

@@ -147,6 +147,11 @@ pub struct AnalysisSpec {
     /// h_w (a heated drum) fits the core's heating from this time on, s (default: when the drum starts heating).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub heating_fit_from_s: Option<f64>,
+    /// Seed 001's height mixing index (`height_mixing_index`) splits the particles into the families above and
+    /// below the bed's median height at the first series row the job writes at or after this time, s (default 0:
+    /// its first row; after a shared preparation, the first row after it: the packed bed the seed starts from).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub height_families_at_s: Option<f64>,
 }
 
 /// The pressure drop of the cycle metrics; see [`AnalysisSpec::cycle_pressure`].
@@ -181,6 +186,7 @@ impl Default for AnalysisSpec {
             mixing_fit_from_s: None,
             cycle_pressure: CyclePressure::Column,
             heating_fit_from_s: None,
+            height_families_at_s: None,
         }
     }
 }

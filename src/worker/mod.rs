@@ -10,6 +10,7 @@
 //! happens when the dispatcher dies, even by `kill -9`; whatever it computed since its last checkpoint is lost, and
 //! nothing is corrupted, since every file it writes is written to a temporary name and renamed.
 
+mod height_families;
 mod prepared;
 pub mod protocol;
 pub(crate) mod reduce;
@@ -154,7 +155,7 @@ fn run(opts: &WorkerOptions) -> Result<i32, Error> {
             }
         }
     }
-    let mut observer = WorkerObserver::new(&job, &built)?;
+    let mut observer = WorkerObserver::new(&job, &built, dir)?;
     let (summary, sim) = run_in_dir(
         &built,
         dir,
@@ -167,6 +168,9 @@ fn run(opts: &WorkerOptions) -> Result<i32, Error> {
             observer: &mut observer,
         },
     )?;
+    if let Some(e) = observer.failure.take() {
+        return Err(e);
+    }
     if !summary.finished {
         emit(Event::Stopped { step: summary.step });
         return Ok(if summary.stopped { EXIT_PREEMPTED } else { 0 });
@@ -240,16 +244,21 @@ struct WorkerObserver {
     job_id: String,
     total_steps: u64,
     mixing: Option<reduce::MixingSampler>,
+    heights: Option<height_families::HeightFamilies>,
+    /// What stopped a sampler (its families file could not be written): the job fails with it after the run.
+    failure: Option<Error>,
     /// False while running a shared preparation: its progress is the job's heartbeat, but the job has not started.
     announce_start: bool,
 }
 
 impl WorkerObserver {
-    fn new(job: &JobSpec, built: &crate::scenario::BuiltScenario) -> Result<Self, Error> {
+    fn new(job: &JobSpec, built: &crate::scenario::BuiltScenario, dir: &Path) -> Result<Self, Error> {
         Ok(WorkerObserver {
             job_id: job.job_id.clone(),
             total_steps: 0,
             mixing: reduce::MixingSampler::new(job, built),
+            heights: height_families::HeightFamilies::new(job, Some(dir))?,
+            failure: None,
             announce_start: true,
         })
     }
@@ -260,6 +269,8 @@ impl WorkerObserver {
             job_id: job.job_id.clone(),
             total_steps: 0,
             mixing: reduce::MixingSampler::new(job, built),
+            heights: height_families::HeightFamilies::new(job, None).ok().flatten(),
+            failure: None,
             announce_start: false,
         }
     }
@@ -267,17 +278,31 @@ impl WorkerObserver {
 
 impl RunObserver for WorkerObserver {
     fn extra_columns(&self) -> String {
-        match &self.mixing {
+        let mut columns = match &self.mixing {
             Some(_) => reduce::MIXING_COLUMNS.to_string(),
             None => String::new(),
+        };
+        if self.heights.is_some() {
+            columns += &format!(",{}", height_families::COLUMN);
         }
+        columns
     }
 
     fn extra_row(&mut self, sim: &crate::engine::Simulation) -> String {
-        match &mut self.mixing {
+        let mut row = match &mut self.mixing {
             Some(m) => m.row(sim),
             None => String::new(),
+        };
+        if let Some(h) = &mut self.heights {
+            match h.row(sim) {
+                Ok(value) => row += &value,
+                Err(e) => {
+                    row += ",nan";
+                    self.failure.get_or_insert(e);
+                }
+            }
         }
+        row
     }
 
     fn event(&mut self, event: RunEvent) {

@@ -217,6 +217,11 @@ pub fn metrics(job: &JobSpec, built: &BuiltScenario, sim: &Simulation, series: &
                 JobMetric::TimeTo90PctMaxLacey => mixing_series()
                     .and_then(|(t, _, lacey)| analysis::fit::time_to_fraction_of_max(&t, &lacey, 0.9))
                     .map_or(f64::NAN, |t| t),
+                // The series column's last value: the end state's row (`height_families`).
+                JobMetric::HeightMixingIndex => series
+                    .column("height_mixing_index")
+                    .and_then(|c| c.iter().rev().find(|v| !v.is_nan()).copied())
+                    .unwrap_or(f64::NAN),
                 JobMetric::MeanHeightTimeAverage => {
                     window(series, "mean_height_m", average_from_s).map_or(f64::NAN, |w| mean(&w))
                 }
