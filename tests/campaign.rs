@@ -9,32 +9,19 @@ use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
 use std::time::Duration;
 
-use common::{granflow, worker_killed_after};
+use common::{drum_slice_base, granflow, worker_killed_after};
 use granflow::checkpoint::CheckpointSeries;
 use granflow::engine::state::first_difference;
 use rand::{RngExt, SeedableRng};
 
 /// A small drum campaign: 2 speeds × 2 fill levels, a fraction of a second each.
 fn campaign(speeds: &str, end_time_s: f64) -> String {
+    let base = drum_slice_base(0.0, end_time_s, 500);
     format!(
         r#"
 name: mini
 seed: 7
-base:
-  domain: {{ lo_m: [-0.021, -0.021, 0.0], hi_m: [0.021, 0.021, 0.0064], periodic: [false, false, true] }}
-  gravity: {{ vector_m_per_s2: [0.0, -9.81, 0.0] }}
-  species:
-    - {{ name: red, radius_m: 0.0015, density_kg_per_m3: 2500.0, youngs_modulus_pa: 5.0e6, poisson_ratio: 0.3, friction_coefficient: 0.4 }}
-    - {{ name: blue, radius_m: 0.0015, density_kg_per_m3: 2500.0, youngs_modulus_pa: 5.0e6, poisson_ratio: 0.3, friction_coefficient: 0.4 }}
-  contact: {{ normal: {{ hertz: {{ restitution: 0.7 }} }}, tangential: mindlin }}
-  walls:
-    - drum: {{ name: drum, species: red, axis_point_m: [0.0, 0.0, 0.0], axis: [0.0, 0.0, 1.0], radius_m: 0.02, rotation_rpm: 30.0 }}
-  fill:
-    - lattice: {{ species: red, spacing_m: 0.0032, lo_m: [-0.02, -0.02, 0.0], hi_m: [0.0, 0.0, 0.0064], origin_m: [0.0016, 0.0016, 0.0016], inside_drum: drum }}
-    - lattice: {{ species: blue, spacing_m: 0.0032, lo_m: [0.0, -0.02, 0.0], hi_m: [0.02, 0.0, 0.0064], origin_m: [0.0016, 0.0016, 0.0016], inside_drum: drum }}
-  time: {{ dt_s: 2.0e-5, end_time_s: {end_time_s} }}
-  output: {{ series_every_steps: 500 }}
-sweep:
+{base}sweep:
   grid:
     - {{ param: walls.0.drum.rotation_rpm, name: rotation_rpm, values: {speeds} }}
     - zip:

@@ -6,7 +6,7 @@ mod common;
 
 use std::path::Path;
 
-use common::{final_state, granflow_ok};
+use common::{drum_slice_base, final_state, granflow_ok};
 use granflow::engine::state::first_difference;
 
 const STRAIGHT: &str = "[ { traditional: { count: 4, length_m: 0.006, half_thickness_m: 0.0006 } } ]";
@@ -15,24 +15,11 @@ const AXIAL: &str = "[ { axial: { count: 3, length_m: 0.008, half_thickness_m: 0
 /// A drum slice of red and blue beads at two speeds; `layouts` is the section that sets the baffles (a `named:`
 /// section and its sweep axis, or the axis with the lists written out).
 fn campaign(named: &str, layout_axis: &str) -> String {
+    let base = drum_slice_base(-0.004, 0.04, 100);
     format!(
         r#"name: layouts
 seed: 7
-base:
-  domain: {{ lo_m: [-0.021, -0.021, 0.0], hi_m: [0.021, 0.021, 0.0064], periodic: [false, false, true] }}
-  gravity: {{ vector_m_per_s2: [0.0, -9.81, 0.0] }}
-  species:
-    - {{ name: red, radius_m: 0.0015, density_kg_per_m3: 2500.0, youngs_modulus_pa: 5.0e6, poisson_ratio: 0.3, friction_coefficient: 0.4 }}
-    - {{ name: blue, radius_m: 0.0015, density_kg_per_m3: 2500.0, youngs_modulus_pa: 5.0e6, poisson_ratio: 0.3, friction_coefficient: 0.4 }}
-  contact: {{ normal: {{ hertz: {{ restitution: 0.7 }} }}, tangential: mindlin }}
-  walls:
-    - drum: {{ name: drum, species: red, axis_point_m: [0.0, 0.0, 0.0], axis: [0.0, 0.0, 1.0], radius_m: 0.02, rotation_rpm: 30.0 }}
-  fill:
-    - lattice: {{ species: red, spacing_m: 0.0032, lo_m: [-0.02, -0.02, 0.0], hi_m: [0.0, -0.004, 0.0064], origin_m: [0.0016, 0.0016, 0.0016], inside_drum: drum }}
-    - lattice: {{ species: blue, spacing_m: 0.0032, lo_m: [0.0, -0.02, 0.0], hi_m: [0.02, -0.004, 0.0064], origin_m: [0.0016, 0.0016, 0.0016], inside_drum: drum }}
-  time: {{ dt_s: 2.0e-5, end_time_s: 0.04 }}
-  output: {{ series_every_steps: 100 }}
-{named}sweep:
+{base}{named}sweep:
   grid:
     - {layout_axis}
     - {{ param: walls.0.drum.rotation_rpm, name: rotation_rpm, values: [20.0, 60.0] }}

@@ -160,25 +160,12 @@ impl Drop for Cluster {
 
 /// Three drum jobs of 0.05 s (2,500 steps), checkpointed every 500 steps, with `executor` (a YAML mapping).
 fn campaign(name: &str, executor: &str, end_time_s: f64) -> String {
+    let base = common::drum_slice_base(0.0, end_time_s, 100);
     format!(
         r#"
 name: {name}
 seed: 5
-base:
-  domain: {{ lo_m: [-0.021, -0.021, 0.0], hi_m: [0.021, 0.021, 0.0064], periodic: [false, false, true] }}
-  gravity: {{ vector_m_per_s2: [0.0, -9.81, 0.0] }}
-  species:
-    - {{ name: red, radius_m: 0.0015, density_kg_per_m3: 2500.0, youngs_modulus_pa: 5.0e6, poisson_ratio: 0.3, friction_coefficient: 0.4 }}
-    - {{ name: blue, radius_m: 0.0015, density_kg_per_m3: 2500.0, youngs_modulus_pa: 5.0e6, poisson_ratio: 0.3, friction_coefficient: 0.4 }}
-  contact: {{ normal: {{ hertz: {{ restitution: 0.7 }} }}, tangential: mindlin }}
-  walls:
-    - drum: {{ name: drum, species: red, axis_point_m: [0.0, 0.0, 0.0], axis: [0.0, 0.0, 1.0], radius_m: 0.02, rotation_rpm: 30.0 }}
-  fill:
-    - lattice: {{ species: red, spacing_m: 0.0032, lo_m: [-0.02, -0.02, 0.0], hi_m: [0.0, 0.0, 0.0064], origin_m: [0.0016, 0.0016, 0.0016], inside_drum: drum }}
-    - lattice: {{ species: blue, spacing_m: 0.0032, lo_m: [0.0, -0.02, 0.0], hi_m: [0.02, 0.0, 0.0064], origin_m: [0.0016, 0.0016, 0.0016], inside_drum: drum }}
-  time: {{ dt_s: 2.0e-5, end_time_s: {end_time_s} }}
-  output: {{ series_every_steps: 100 }}
-sweep:
+{base}sweep:
   grid:
     - {{ param: walls.0.drum.rotation_rpm, name: rotation_rpm, values: [10.0, 20.0, 40.0] }}
 metrics: [kinetic_energy_j, coordination_number, mixing_rate_constant_per_s]

@@ -373,49 +373,25 @@ pub fn check(spec: &CampaignSpec) -> Result<Vec<JobMetric>, (String, String)> {
         }
         metrics.push(m);
     }
-    if let Some(t) = spec.analysis.average_from_s
-        && !(t.is_finite() && t >= 0.0 && t < spec.base.time.end_time_s)
-    {
-        return Err((
-            "analysis.average_from_s".into(),
-            format!(
-                "expected 0 <= value < the end time ({} s), got {t}",
-                spec.base.time.end_time_s
-            ),
-        ));
-    }
-    if let Some(t) = spec.analysis.mixing_fit_from_s
-        && !(t.is_finite() && t >= 0.0 && t < spec.base.time.end_time_s)
-    {
-        return Err((
-            "analysis.mixing_fit_from_s".into(),
-            format!(
-                "expected 0 <= value < the end time ({} s), got {t}",
-                spec.base.time.end_time_s
-            ),
-        ));
-    }
-    if let Some(t) = spec.analysis.heating_fit_from_s
-        && !(t.is_finite() && t >= 0.0 && t < spec.base.time.end_time_s)
-    {
-        return Err((
-            "analysis.heating_fit_from_s".into(),
-            format!(
-                "expected 0 <= value < the end time ({} s), got {t}",
-                spec.base.time.end_time_s
-            ),
-        ));
-    }
-    if let Some(t) = spec.analysis.height_families_at_s
-        && !(t.is_finite() && t >= 0.0 && t < spec.base.time.end_time_s)
-    {
-        return Err((
-            "analysis.height_families_at_s".into(),
-            format!(
-                "expected 0 <= value < the end time ({} s), got {t}",
-                spec.base.time.end_time_s
-            ),
-        ));
+    // Times inside the run at which an analysis starts or takes something.
+    let a = &spec.analysis;
+    for (key, time_s) in [
+        ("average_from_s", a.average_from_s),
+        ("mixing_fit_from_s", a.mixing_fit_from_s),
+        ("heating_fit_from_s", a.heating_fit_from_s),
+        ("height_families_at_s", a.height_families_at_s),
+    ] {
+        if let Some(t) = time_s
+            && !(t.is_finite() && t >= 0.0 && t < spec.base.time.end_time_s)
+        {
+            return Err((
+                format!("analysis.{key}"),
+                format!(
+                    "expected 0 <= value < the end time ({} s), got {t}",
+                    spec.base.time.end_time_s
+                ),
+            ));
+        }
     }
     if spec.analysis.mixing_neighbours == 0 {
         return Err(("analysis.mixing_neighbours".into(), "expected at least 1".into()));

@@ -246,3 +246,26 @@ pub fn worker_killed_after(dir: &Path, delay: std::time::Duration) -> bool {
     let _ = child.wait();
     finished
 }
+
+/// The `base:` section (with its key) of the small drum campaigns of the campaign tests: a slice of a 40 mm drum at
+/// 30 rpm, red beads on the left and blue on the right of a lattice filled up to the height `fill_top_m`, run to
+/// `end_time_s` at dt = 20 µs with a series row every `series_every_steps`.
+pub fn drum_slice_base(fill_top_m: f64, end_time_s: f64, series_every_steps: u64) -> String {
+    format!(
+        r#"base:
+  domain: {{ lo_m: [-0.021, -0.021, 0.0], hi_m: [0.021, 0.021, 0.0064], periodic: [false, false, true] }}
+  gravity: {{ vector_m_per_s2: [0.0, -9.81, 0.0] }}
+  species:
+    - {{ name: red, radius_m: 0.0015, density_kg_per_m3: 2500.0, youngs_modulus_pa: 5.0e6, poisson_ratio: 0.3, friction_coefficient: 0.4 }}
+    - {{ name: blue, radius_m: 0.0015, density_kg_per_m3: 2500.0, youngs_modulus_pa: 5.0e6, poisson_ratio: 0.3, friction_coefficient: 0.4 }}
+  contact: {{ normal: {{ hertz: {{ restitution: 0.7 }} }}, tangential: mindlin }}
+  walls:
+    - drum: {{ name: drum, species: red, axis_point_m: [0.0, 0.0, 0.0], axis: [0.0, 0.0, 1.0], radius_m: 0.02, rotation_rpm: 30.0 }}
+  fill:
+    - lattice: {{ species: red, spacing_m: 0.0032, lo_m: [-0.02, -0.02, 0.0], hi_m: [0.0, {fill_top_m:?}, 0.0064], origin_m: [0.0016, 0.0016, 0.0016], inside_drum: drum }}
+    - lattice: {{ species: blue, spacing_m: 0.0032, lo_m: [0.0, -0.02, 0.0], hi_m: [0.02, {fill_top_m:?}, 0.0064], origin_m: [0.0016, 0.0016, 0.0016], inside_drum: drum }}
+  time: {{ dt_s: 2.0e-5, end_time_s: {end_time_s:?} }}
+  output: {{ series_every_steps: {series_every_steps} }}
+"#
+    )
+}
