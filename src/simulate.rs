@@ -234,6 +234,32 @@ fn drying_columns(sim: &Simulation) -> String {
     )
 }
 
+/// The series columns of a run with a spray: the liquid sprayed onto the particles since the start, m³, and the
+/// coating variability CV_m of the particles' coating mass gain (seed 000 eq. 6.45, `Simulation::coating_gain_m3`;
+/// `nan` before the first spray).
+const SPRAY_SERIES_COLUMNS: &str = ",sprayed_m3,coating_variability";
+
+fn sprays(built: &BuiltScenario) -> bool {
+    matches!(
+        built.spec.cohesion,
+        Some(crate::engine::models::cohesion_law::CohesionModel::LiquidBridge(
+            crate::engine::models::cohesion_law::LiquidBridge { spray: Some(_), .. }
+        ))
+    )
+}
+
+/// The [`SPRAY_SERIES_COLUMNS`], empty without a spray.
+fn spray_columns(sim: &Simulation, built: &BuiltScenario) -> String {
+    if !sprays(built) {
+        return String::new();
+    }
+    format!(
+        ",{:e},{:e}",
+        sim.particles.sprayed_m3.iter().sum::<f64>(),
+        crate::engine::spray::coating_variability(&sim.coating_gain_m3())
+    )
+}
+
 /// The series header of a scenario (before any observer columns).
 pub fn series_header(built: &BuiltScenario) -> String {
     let mut header = SERIES_HEADER.to_string();
@@ -248,6 +274,9 @@ pub fn series_header(built: &BuiltScenario) -> String {
     }
     if built.gas.as_ref().is_some_and(|g| g.drying.is_some()) {
         header.push_str(DRYING_SERIES_COLUMNS);
+    }
+    if sprays(built) {
+        header.push_str(SPRAY_SERIES_COLUMNS);
     }
     if built.spec.output.net_forces {
         header.push_str(",weight_n,fluid_force_up_n");
@@ -376,6 +405,7 @@ fn series_row(sim: &mut Simulation, built: &BuiltScenario) -> String {
         ));
     }
     heat.push_str(&drying_columns(sim));
+    heat.push_str(&spray_columns(sim, built));
     format!(
         "{},{:e},{:e},{:e},{:e},{:e},{},{},{:.6}{gas}{heat}{net}",
         sim.step,

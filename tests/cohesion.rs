@@ -76,6 +76,31 @@ fn b4_liquid_is_conserved_while_bridges_form_and_break() {
     );
     assert!(worst < 1e-10, "liquid drifted by {worst:e} of the total");
     assert!(!s.contacts.cohesion().walls.is_empty(), "bridges to the drum stand");
+    // The coating mass gains (CV_m's distribution) share out every particle's film and bridge liquid, less the start:
+    // they sum to what was sprayed (B4's ledger), and bridges have carried sprayed liquid to particles the spray
+    // never reached.
+    let gains = sim.coating_gain_m3();
+    let start_of =
+        |i: usize| b.config.species.get(s.particles.species[i]).liquid_content * s.particles.radius_m[i].powi(3);
+    let held: f64 = gains.iter().enumerate().map(|(i, g)| g + start_of(i)).sum();
+    let total = s.particles.liquid_m3.iter().sum::<f64>() + s.contacts.bridge_liquid_m3();
+    assert!(
+        (held / total - 1.0).abs() < 1e-12,
+        "held {held:e} vs particles + bridges {total:e}"
+    );
+    let gained: f64 = gains.iter().sum();
+    assert!(
+        (gained / sprayed - 1.0).abs() < 1e-9,
+        "gains {gained:e} vs sprayed {sprayed:e}"
+    );
+    let reached_by_bridges = (0..gains.len())
+        .filter(|&i| s.particles.sprayed_m3[i] == 0.0 && gains[i] > 0.0)
+        .count();
+    println!(
+        "coating gains: CV_m {:.3} (direct spray alone {:.3}); {reached_by_bridges} unsprayed particles gained liquid",
+        granflow::engine::spray::coating_variability(&gains),
+        granflow::engine::spray::coating_variability(&s.particles.sprayed_m3)
+    );
 }
 
 /// Bridges survive the two-level neighbour list's refilters: the wet drum ends with the same bits with the force

@@ -1,4 +1,5 @@
-//! Reductions of a metric's time series: the exponential mixing-rate fit and the time to a fraction of the maximum.
+//! Reductions of a metric's time series: the exponential mixing-rate fit, the time to a fraction of the maximum, and
+//! a least-squares line with its intercept's standard error (seed 000 §6.3.2's CV_m against 1/√t).
 //!
 //! Seed 000 §4.1.3 extracts "a mixing rate constant" by "fitting [the IS(t)] data to an exponential function"
 //! (Fig. 50), and §2.5.2 / Table 1 report the time at which the Lacey index first reaches 90 % of its maximum. Both
@@ -285,6 +286,58 @@ pub fn time_to_fraction_of_max(t_s: &[f64], y: &[f64], fraction: f64) -> Option<
     None
 }
 
+/// A least-squares line y = slope · x + intercept, with what tells a line through the origin from one that is not.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct LineFit {
+    pub slope: f64,
+    pub intercept: f64,
+    /// The intercept's standard error, s·√(1/n + x̄²/S_xx) with s² the residuals' sum of squares over n − 2 (NaN
+    /// with two points).
+    pub intercept_std_error: f64,
+    /// R² = S_xy²/(S_xx S_yy); 1 when y does not vary.
+    pub r_squared: f64,
+}
+
+/// Fits y = slope · x + intercept by ordinary least squares. `None` with fewer than two points or no spread in x.
+/// Points with a non-finite x or y are skipped.
+///
+/// # Panics
+/// If the slices differ in length.
+pub fn fit_line(x: &[f64], y: &[f64]) -> Option<LineFit> {
+    assert_eq!(x.len(), y.len(), "fit_line: one y per x");
+    let (x, y): (Vec<f64>, Vec<f64>) = x
+        .iter()
+        .zip(y)
+        .filter(|(x, y)| x.is_finite() && y.is_finite())
+        .map(|(&x, &y)| (x, y))
+        .unzip();
+    if x.len() < 2 {
+        return None;
+    }
+    let n = x.len() as f64;
+    let (mx, my) = (x.iter().sum::<f64>() / n, y.iter().sum::<f64>() / n);
+    let sxx: f64 = x.iter().map(|x| (x - mx) * (x - mx)).sum();
+    let sxy: f64 = x.iter().zip(&y).map(|(x, y)| (x - mx) * (y - my)).sum();
+    let syy: f64 = y.iter().map(|y| (y - my) * (y - my)).sum();
+    if !(sxx > 0.0) {
+        return None;
+    }
+    let slope = sxy / sxx;
+    let intercept = my - slope * mx;
+    let residual_ss: f64 = x.iter().zip(&y).map(|(x, y)| (y - intercept - slope * x).powi(2)).sum();
+    let intercept_std_error = if x.len() > 2 {
+        (residual_ss / (n - 2.0) * (1.0 / n + mx * mx / sxx)).sqrt()
+    } else {
+        f64::NAN
+    };
+    Some(LineFit {
+        slope,
+        intercept,
+        intercept_std_error,
+        r_squared: if syy > 0.0 { sxy * sxy / (sxx * syy) } else { 1.0 },
+    })
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -443,5 +496,32 @@ mod tests {
         let fixed = fit_exponential_decay_to(&t, &stall, 0.15).unwrap();
         assert!((free.rate_constant_per_s - 3.0).abs() < 1e-6);
         assert!(fixed.rate_constant_per_s < 0.5 * free.rate_constant_per_s, "{fixed:?}");
+    }
+
+    #[test]
+    fn a_line_fit_recovers_an_exact_line_and_the_textbook_intercept_error() {
+        let x = [1.0, 2.0, 3.0, 4.0];
+        let exact: Vec<f64> = x.iter().map(|x| 2.5 * x - 1.0).collect();
+        let f = fit_line(&x, &exact).unwrap();
+        assert!(
+            (f.slope - 2.5).abs() < 1e-12 && (f.intercept + 1.0).abs() < 1e-12,
+            "{f:?}"
+        );
+        assert!(
+            f.intercept_std_error.abs() < 1e-12 && (f.r_squared - 1.0).abs() < 1e-12,
+            "{f:?}"
+        );
+        // y = 0, 1, 1, 2 on x = 0..3: slope 0.6, intercept 0.1, residuals -0.1, 0.3, -0.3, 0.1 (SS 0.2),
+        // s² = 0.1, SE(b) = sqrt(0.1 (1/4 + 2.25/5)) = sqrt(0.07).
+        let f = fit_line(&[0.0, 1.0, 2.0, 3.0], &[0.0, 1.0, 1.0, 2.0]).unwrap();
+        assert!(
+            (f.slope - 0.6).abs() < 1e-12 && (f.intercept - 0.1).abs() < 1e-12,
+            "{f:?}"
+        );
+        assert!((f.intercept_std_error - 0.07f64.sqrt()).abs() < 1e-12, "{f:?}");
+        assert!((f.r_squared - 0.9).abs() < 1e-12, "{f:?}");
+        assert!(fit_line(&[1.0, 1.0], &[0.0, 1.0]).is_none());
+        assert!(fit_line(&[1.0, f64::NAN], &[0.0, 1.0]).is_none());
+        assert!(fit_line(&[0.0, 1.0], &[0.0, 1.0]).unwrap().intercept_std_error.is_nan());
     }
 }

@@ -225,15 +225,9 @@ pub fn cycle_velocities(levels: &[CycleLevel], bed_weight_per_area_pa: f64) -> C
     }
 }
 
-/// Least-squares line y = a x + b.
+/// Least-squares line y = a x + b (NaN without a spread in x).
 fn fit_line(x: &[f64], y: &[f64]) -> (f64, f64) {
-    let n = x.len() as f64;
-    let mx = x.iter().sum::<f64>() / n;
-    let my = y.iter().sum::<f64>() / n;
-    let sxy: f64 = x.iter().zip(y).map(|(x, y)| (x - mx) * (y - my)).sum();
-    let sxx: f64 = x.iter().map(|x| (x - mx) * (x - mx)).sum();
-    let a = sxy / sxx;
-    (a, my - a * mx)
+    super::fit::fit_line(x, y).map_or((f64::NAN, f64::NAN), |f| (f.slope, f.intercept))
 }
 
 #[cfg(test)]

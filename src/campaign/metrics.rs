@@ -82,6 +82,8 @@ job_metrics! {
         "k of an exponential fit to IS(t) (seed 000 §4.1.3)";
     MixingRateToRandom => "mixing_rate_to_random_per_s", "1/s", [MixingSpecies],
         "k of IS(t) = IS_R + b exp(-k t) with IS_R = sqrt(P(1-P)/n) the random mixture's IS (n particles per local sample): the approach to a random mixture";
+    IntensityOfSegregationTimeAverage => "intensity_of_segregation_time_avg", "1", [MixingSpecies],
+        "IS averaged over the mixing samples from analysis.average_from_s: the asymptotic state's segregation that seed 000 §4.2.2 compares wet against dry (Figs 52-53)";
     TimeTo90PctMaxLacey => "time_to_90pct_max_lacey_s", "s", [MixingSpecies],
         "first time the Lacey index reaches 90 % of its maximum (seed 000 Table 1)";
     HeightMixingIndex => "height_mixing_index", "1", [],
@@ -131,7 +133,15 @@ job_metrics! {
     SteppedFluidizationVelocity => "stepped_fluidization_velocity_m_per_s", "m/s", [Gas, InflowLevels],
         "u_mf of a gas.inflow_levels run stepping the gas up: the slowest level of the rising branch from which the bed keeps moving (σ(ΔP) over the second half of each hold ≥ 1 % of W/A) at every faster level; NaN when the levels do not bracket the onset";
     CoatingVariability => "coating_variability", "1", [Spray],
-        "CV_m = σ/μ of the liquid each particle received from the spray (seed 000 eq. 6.45)";
+        "CV_m = σ/μ of the particles' coating mass gain (seed 000 eq. 6.45): the liquid each holds (film, half of each particle bridge, its wall bridges) less its start, so liquid the bridges carried inward counts (§6.3.2)";
+    CoatingVariabilityFitSlope => "coating_variability_fit_slope_sqrt_s", "s^1/2", [Spray],
+        "slope of the least-squares line of CV_m against 1/√t, t the coating time since spray.start_s, over the series rows from analysis.coating_fit_from_s of coating time (seed 000 §6.3.2, eq. 6.46: CV_m ∝ 1/√t)";
+    CoatingVariabilityFitIntercept => "coating_variability_fit_intercept", "1", [Spray],
+        "that line's intercept (seed 000 Figs 85-86: through the origin for Bo_g < 1, positive for Bo_g > 1)";
+    CoatingVariabilityFitInterceptStdError => "coating_variability_fit_intercept_std_error", "1", [Spray],
+        "the intercept's standard error, s·√(1/n + x̄²/S_xx), with the series rows as the samples (they are correlated in time, so it is a lower bound)";
+    CoatingVariabilityFitRSquared => "coating_variability_fit_r_squared", "1", [Spray],
+        "R² of that line (seed 000 Fig. 85: 'a linear correlation' beyond 1 s)";
     MeanCollisionDuration => "mean_collision_duration_s", "s", [ContactStatistics],
         "mean duration of the particle-particle contacts that ended during the run (Hertz: t_c = 2.87 (m*^2/(R* E*^2 v))^(1/5))";
     MeanWallContactDuration => "mean_wall_contact_duration_s", "s", [ContactStatistics],
@@ -380,6 +390,7 @@ pub fn check(spec: &CampaignSpec) -> Result<Vec<JobMetric>, (String, String)> {
         ("mixing_fit_from_s", a.mixing_fit_from_s),
         ("heating_fit_from_s", a.heating_fit_from_s),
         ("height_families_at_s", a.height_families_at_s),
+        ("coating_fit_from_s", a.coating_fit_from_s),
     ] {
         if let Some(t) = time_s
             && !(t.is_finite() && t >= 0.0 && t < spec.base.time.end_time_s)

@@ -152,6 +152,11 @@ pub struct AnalysisSpec {
     /// its first row; after a shared preparation, the first row after it: the packed bed the seed starts from).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub height_families_at_s: Option<f64>,
+    /// The line of CV_m against 1/√t (the `coating_variability_fit_*` metrics), t the coating time since the spray
+    /// started (`spray.start_s`), takes the series from this coating time on, s (default 1: seed 000 §6.3.2, "all
+    /// data achieved over 1 second show a linear correlation").
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub coating_fit_from_s: Option<f64>,
 }
 
 /// The pressure drop of the cycle metrics; see [`AnalysisSpec::cycle_pressure`].
@@ -187,6 +192,7 @@ impl Default for AnalysisSpec {
             cycle_pressure: CyclePressure::Column,
             heating_fit_from_s: None,
             height_families_at_s: None,
+            coating_fit_from_s: None,
         }
     }
 }

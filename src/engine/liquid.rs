@@ -347,6 +347,27 @@ impl Exchange<'_> {
     }
 }
 
+/// The liquid each particle holds, m³: its film, half of each bridge to another particle and the whole of each bridge
+/// to a wall (the shares a bridge's liquid goes back in when its record is dropped, `AlignedHistory::from_store`).
+pub fn held_liquid_m3(liquid_m3: &[f64], history: &AlignedHistory, list: &NeighborList) -> Vec<f64> {
+    let mut held = liquid_m3.to_vec();
+    for i in 0..held.len() {
+        for k in list.pairs_of(i) {
+            if history.pair.occupied(k) {
+                let volume = history.pair.cohesion.bridge_volume_m3[k];
+                held[i] += 0.5 * volume;
+                held[list.partner[k] as usize] += volume - 0.5 * volume;
+            }
+        }
+        for k in list.walls_of(i) {
+            if history.wall.occupied(k) {
+                held[i] += history.wall.cohesion.bridge_volume_m3[k];
+            }
+        }
+    }
+    held
+}
+
 /// Liquid on the particles and in the bridges, m³.
 pub fn total_liquid_m3(liquid_m3: &[f64], history: &AlignedHistory) -> f64 {
     liquid_m3.iter().sum::<f64>()

@@ -136,7 +136,7 @@ pub struct Particles {
     pub torque_n_m: Vec<Vec3>,
     /// Liquid carried on the particle's surface (not in bridges), m³.
     pub liquid_m3: Vec<f64>,
-    /// Liquid the particle has received from the spray since the start, m³ (for the coating variability CV_m).
+    /// Liquid the particle has received from the spray since the start, m³ (the liquid ledger's "sprayed" term).
     pub sprayed_m3: Vec<f64>,
     /// Temperature of each (lumped) particle, K; empty in a run without heat transfer (`engine::heat`).
     pub temperature_k: Vec<f64>,

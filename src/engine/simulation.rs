@@ -761,6 +761,19 @@ impl Simulation {
         Some(self.held_energy_j()? / ledger.expected_energy_j() - 1.0)
     }
 
+    /// The coating mass gain of each particle, m³ of liquid (seed 000 eq. 6.45's distribution): the liquid it holds
+    /// now (its film, half of each bridge to another particle, all of each bridge to a wall) less the film its
+    /// species started with. Liquid the spray put on a surface particle counts wherever bridges have carried it
+    /// since: seed 000 §6.3.2 explains CV_m's fall by the transfer from the sprayed layer to the particles inside.
+    pub fn coating_gain_m3(&self) -> Vec<f64> {
+        let p = &self.particles;
+        let mut held = super::liquid::held_liquid_m3(&p.liquid_m3, &self.history, &self.work.list);
+        for (i, h) in held.iter_mut().enumerate() {
+            *h -= self.config.species.get(p.species[i]).liquid_content * p.radius_m[i].powi(3);
+        }
+        held
+    }
+
     /// Liquid on the particles plus liquid in bridges, m³.
     pub fn total_liquid_m3(&self) -> f64 {
         total_liquid_m3(&self.particles.liquid_m3, &self.history)

@@ -53,7 +53,8 @@ pub fn spray_surface(p: &mut Particles, g: &Vec3, max_liquid_content: f64) -> f6
     total
 }
 
-/// CV_m = σ_m/μ_m of the liquid each particle has gained from the spray (seed 000 eq 6.45); NaN before any spray.
+/// CV_m = σ_m/μ_m of the particles' coating mass gains (seed 000 eq 6.45; `Simulation::coating_gain_m3`); NaN
+/// before any gain.
 pub fn coating_variability(sprayed_m3: &[f64]) -> f64 {
     let n = sprayed_m3.len() as f64;
     let mean = sprayed_m3.iter().sum::<f64>() / n;

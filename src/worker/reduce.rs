@@ -186,6 +186,24 @@ pub fn metrics(job: &JobSpec, built: &BuiltScenario, sim: &Simulation, series: &
             .min_by(|&a, &b| temperature[a].total_cmp(&temperature[b]))
             .map(|k| (t[k], temperature[k]))
     };
+    // CV_m against 1/√t, t the coating time (since the spray started), from analysis.coating_fit_from_s on
+    // (seed 000 §6.3.2).
+    let coating_fit = || {
+        let Some(CohesionModel::LiquidBridge(bridge)) = &built.spec.cohesion else {
+            return None;
+        };
+        let spray_start_s = bridge.spray.as_ref()?.start_s;
+        let from_s = job.analysis.coating_fit_from_s.unwrap_or(1.0);
+        let (t, cv) = (series.column("time_s")?, series.column("coating_variability")?);
+        let (x, y): (Vec<f64>, Vec<f64>) = t
+            .iter()
+            .map(|t| t - spray_start_s)
+            .zip(cv)
+            .filter(|(t, _)| *t >= from_s && *t > 0.0)
+            .map(|(t, cv)| (1.0 / t.sqrt(), *cv))
+            .unzip();
+        analysis::fit::fit_line(&x, &y)
+    };
     let bed_once = std::cell::OnceCell::new();
     let bed = || *bed_once.get_or_init(|| wall_heat(job, sim, series, "mean_temperature_k"));
     job.metrics
@@ -213,6 +231,9 @@ pub fn metrics(job: &JobSpec, built: &BuiltScenario, sim: &Simulation, series: &
                     mixing_series()
                         .and_then(|(t, is, _)| analysis::fit::fit_exponential_decay_to(&t, &is, random))
                         .map_or(f64::NAN, |f| f.rate_constant_per_s)
+                }
+                JobMetric::IntensityOfSegregationTimeAverage => {
+                    window(series, "intensity_of_segregation", average_from_s).map_or(f64::NAN, |w| mean(&w))
                 }
                 JobMetric::TimeTo90PctMaxLacey => mixing_series()
                     .and_then(|(t, _, lacey)| analysis::fit::time_to_fraction_of_max(&t, &lacey, 0.9))
@@ -245,7 +266,13 @@ pub fn metrics(job: &JobSpec, built: &BuiltScenario, sim: &Simulation, series: &
                 | JobMetric::GranularCapillaryNumber22
                 | JobMetric::GranularCapillaryNumber12
                 | JobMetric::WetPhaseMixed => wet_number(metric, job, built, sim),
-                JobMetric::CoatingVariability => crate::engine::spray::coating_variability(&sim.particles.sprayed_m3),
+                JobMetric::CoatingVariability => crate::engine::spray::coating_variability(&sim.coating_gain_m3()),
+                JobMetric::CoatingVariabilityFitSlope => coating_fit().map_or(f64::NAN, |f| f.slope),
+                JobMetric::CoatingVariabilityFitIntercept => coating_fit().map_or(f64::NAN, |f| f.intercept),
+                JobMetric::CoatingVariabilityFitInterceptStdError => {
+                    coating_fit().map_or(f64::NAN, |f| f.intercept_std_error)
+                }
+                JobMetric::CoatingVariabilityFitRSquared => coating_fit().map_or(f64::NAN, |f| f.r_squared),
                 JobMetric::MeanCollisionDuration => sim.particles.channels.mean_collision_duration_s(),
                 JobMetric::MeanWallContactDuration => sim.particles.channels.mean_wall_contact_duration_s(),
                 JobMetric::WallContactTimeFraction => sim.particles.channels.wall_contact_time_fraction(sim.time_s),
