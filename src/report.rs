@@ -107,6 +107,11 @@ fn evaluate(
         reference.extend(check.relative_to.clone());
         ours /= mean_for(&reference).0;
     }
+    if !check.difference_from.is_empty() {
+        let mut reference = check.filter.clone();
+        reference.extend(check.difference_from.clone());
+        ours -= mean_for(&reference).0;
+    }
     let (pass, criterion) = match (check.tolerance_rel, check.range) {
         (Some(t), _) => (
             (ours / check.expected - 1.0).abs() <= t,
@@ -359,6 +364,40 @@ mod tests {
         let result = evaluate(&check, &header, &rows, &[]);
         assert_eq!(result.ours, 3.0 / 8.0);
         assert!(result.pass);
+    }
+
+    /// A check with `difference_from` subtracts the reference jobs' mean; with both it and `relative_to` the
+    /// section is refused.
+    #[test]
+    fn difference_checks_subtract_the_reference_jobs() {
+        let header: Vec<String> = ["status", "param.layout", "metric.m [1]"]
+            .iter()
+            .map(|s| s.to_string())
+            .collect();
+        let row = |l: &str, m: f64| vec![Value::from("done"), Value::from(l), Value::from(m)];
+        let rows = vec![row("unbaffled", 0.5), row("axial", 0.875), row("axial", 0.625)];
+        let parse = |yaml: &str| -> CheckSpec {
+            serde_norway::with::singleton_map_recursive::deserialize(serde_norway::Deserializer::from_str(yaml))
+                .expect("parses")
+        };
+        let check = parse(
+            "{ name: axial above unbaffled, value: { metric: m }, where: { layout: axial }, difference_from: { layout: unbaffled }, expected: 0.25, range: [0.25, 1.0] }",
+        );
+        let result = evaluate(&check, &header, &rows, &[]);
+        assert_eq!((result.ours, result.samples), (0.25, 2));
+        assert!(result.pass);
+        let both = parse(
+            "{ name: both, value: { metric: m }, relative_to: { layout: unbaffled }, difference_from: { layout: unbaffled }, expected: 0.25, range: [0.25, 1.0] }",
+        );
+        let spec = crate::campaign::validation::ValidationSpec {
+            case: "F1".into(),
+            title: "t".into(),
+            source: "s".into(),
+            choices: vec![],
+            checks: vec![both],
+        };
+        let err = spec.check(&["m".to_string()]).expect_err("refused");
+        assert_eq!(err.0, "validation.checks[0].difference_from");
     }
 
     /// A swept section (a map, or null for none) is stored as JSON text; `where` and `relative_to` match it by

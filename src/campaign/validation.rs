@@ -32,6 +32,11 @@ pub struct CheckSpec {
     /// a wet run's u_mf over the dry run's. Empty: no division.
     #[serde(default, skip_serializing_if = "std::collections::BTreeMap::is_empty")]
     pub relative_to: std::collections::BTreeMap<String, serde_json::Value>,
+    /// Subtract the same value for the jobs (or groups) matching `where` with these parameter values put in: e.g.
+    /// a baffled drum's Lacey index less the unbaffled drum's ("25 points above"). Empty: no subtraction; not
+    /// together with `relative_to`.
+    #[serde(default, skip_serializing_if = "std::collections::BTreeMap::is_empty")]
+    pub difference_from: std::collections::BTreeMap<String, serde_json::Value>,
     /// The source's number.
     pub expected: f64,
     /// Pass when |ours/expected − 1| ≤ this ...
@@ -74,6 +79,12 @@ impl ValidationSpec {
                         "give exactly one of tolerance_rel (> 0) and range ([min, max])".into(),
                     ));
                 }
+            }
+            if !c.relative_to.is_empty() && !c.difference_from.is_empty() {
+                return Err((
+                    key("difference_from"),
+                    "give at most one of relative_to (a ratio) and difference_from (a difference)".into(),
+                ));
             }
             let needed: Vec<&String> = match &c.value {
                 CheckValue::Metric(m) => vec![m],

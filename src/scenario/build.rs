@@ -9,12 +9,14 @@ use std::sync::Arc;
 
 use rand::RngExt;
 
+mod walls;
+
 use super::ConfigError;
-use super::spec::{BaffleSpec, FillSpec, GravitySpec, ScenarioSpec, SpeciesSpec, WallSpec};
+use super::spec::{FillSpec, GravitySpec, ScenarioSpec, SpeciesSpec, WallSpec};
 use crate::engine::Vec3;
 use crate::engine::channels::ParticleChannels;
 use crate::engine::cohesion::Cohesion;
-use crate::engine::geometry::{Domain, Gravity, GravityFlip, RotatingFrame, Wall, WallShape};
+use crate::engine::geometry::{Domain, Gravity, GravityFlip, Wall, WallShape};
 use crate::engine::models::cohesion_law::CohesionModel;
 use crate::engine::models::{ContactLaw, NormalModel, PairTable, TangentialModel};
 use crate::engine::particles::{Particles, Species, SpeciesId, SpeciesTable};
@@ -156,7 +158,7 @@ pub fn build(spec: ScenarioSpec, path: &Path) -> Result<BuiltScenario, ConfigErr
     }
 
     check_memory(&c, &spec)?;
-    let walls = build_walls(&c, &spec, &species, &domain)?;
+    let walls = walls::build_walls(&c, &spec, &species, &domain)?;
     let mut rng = RngState::from_seed_u64(spec.seed).restore();
     let (mut particles, fill_ends) = fill(&c, &spec, &species, &domain, &walls, &mut rng)?;
 
@@ -554,223 +556,6 @@ fn check_contact_law(c: &Checker, law: &ContactLaw) -> Result<(), ConfigError> {
         TangentialModel::Mindlin => {}
     }
     Ok(())
-}
-
-fn build_walls(
-    c: &Checker,
-    spec: &ScenarioSpec,
-    species: &SpeciesTable,
-    domain: &Domain,
-) -> Result<Vec<Wall>, ConfigError> {
-    let mut walls = Vec::new();
-    for (k, w) in spec.walls.iter().enumerate() {
-        match w {
-            WallSpec::Box { species: s } => {
-                let id = c.species(&format!("walls[{k}].box.species"), species, s)?;
-                for axis in 0..3 {
-                    if domain.periodic[axis] {
-                        continue;
-                    }
-                    let axis_name = ["x", "y", "z"][axis];
-                    for (side, point, sign) in [("lo", domain.lo_m, 1.0), ("hi", domain.hi_m, -1.0)] {
-                        let mut normal = Vec3::zeros();
-                        normal[axis] = sign;
-                        walls.push(Wall {
-                            name: format!("box_{axis_name}_{side}"),
-                            species: id,
-                            shape: WallShape::Plane { point_m: point, normal },
-                        });
-                    }
-                }
-            }
-            WallSpec::Plane {
-                name,
-                species: s,
-                point_m,
-                normal,
-            } => {
-                let id = c.species(&format!("walls[{k}].plane.species"), species, s)?;
-                c.finite3(&format!("walls[{k}].plane.point_m"), point_m)?;
-                let n = c.unit3(&format!("walls[{k}].plane.normal"), normal)?;
-                walls.push(Wall {
-                    name: name.clone(),
-                    species: id,
-                    shape: WallShape::Plane {
-                        point_m: Vec3::from(*point_m),
-                        normal: n,
-                    },
-                });
-            }
-            WallSpec::Drum(d) => {
-                let key = |f: &str| format!("walls[{k}].drum.{f}");
-                let id = c.species(&key("species"), species, &d.species)?;
-                c.finite3(&key("axis_point_m"), &d.axis_point_m)?;
-                let axis = c.unit3(&key("axis"), &d.axis)?;
-                c.positive(&key("radius_m"), d.radius_m)?;
-                // The drum's cross-section must lie in the box on every non-periodic axis across its axis: outside
-                // the box a particle is lost, so a drum larger than the domain fails the run instead of confining it.
-                // (Along an axis the drum's axis is not perpendicular to, the cylinder is unbounded and the box
-                // caps it.)
-                for a in 0..3 {
-                    if domain.periodic[a] || axis[a].abs() > 1e-9 {
-                        continue;
-                    }
-                    let (lo, hi) = (d.axis_point_m[a] - d.radius_m, d.axis_point_m[a] + d.radius_m);
-                    if lo < domain.lo_m[a] || hi > domain.hi_m[a] {
-                        let axis_name = ["x", "y", "z"][a];
-                        return Err(c.fail(
-                            key("radius_m"),
-                            format!(
-                                "expected the drum inside the domain along {axis_name} ({} to {} m), got {lo} to {hi} m (axis point {} m, radius {} m)",
-                                domain.lo_m[a], domain.hi_m[a], d.axis_point_m[a], d.radius_m
-                            ),
-                        ));
-                    }
-                }
-                if !d.rotation_rpm.is_finite() {
-                    return Err(c.fail(
-                        key("rotation_rpm"),
-                        format!("expected a finite number, got {}", d.rotation_rpm),
-                    ));
-                }
-                let omega = d.rotation_rpm * 2.0 * PI / 60.0;
-                let frame = RotatingFrame::new(Vec3::from(d.axis_point_m), axis, omega);
-                walls.push(Wall {
-                    name: d.name.clone(),
-                    species: id,
-                    shape: WallShape::RotatingCylinder {
-                        frame,
-                        radius_m: d.radius_m,
-                    },
-                });
-                for (b, baffle) in d.baffles.iter().enumerate() {
-                    let bkey = |f: &str| format!("walls[{k}].drum.baffles[{b}].{f}");
-                    for (s, (start, end), half) in baffle_segments(c, baffle, d.radius_m, &bkey)? {
-                        // A plate must stay inside the drum (a wall baffle's foot sits on the wall itself).
-                        let farthest_m = start[0].hypot(start[1]).max(end[0].hypot(end[1]));
-                        if farthest_m.is_nan() || farthest_m > d.radius_m * (1.0 + 1e-9) {
-                            return Err(c.fail(
-                                format!("walls[{k}].drum.baffles[{b}]"),
-                                format!(
-                                    "plate {s} reaches {farthest_m} m from the axis: outside the drum radius {} m",
-                                    d.radius_m
-                                ),
-                            ));
-                        }
-                        walls.push(Wall {
-                            name: format!("{}_baffle_{b}_{s}", d.name),
-                            species: id,
-                            shape: WallShape::Baffle {
-                                frame,
-                                start_m: start,
-                                end_m: end,
-                                half_thickness_m: half,
-                            },
-                        });
-                    }
-                }
-            }
-        }
-    }
-    if walls.len() > u16::MAX as usize {
-        return Err(c.fail("walls", format!("at most {} walls, got {}", u16::MAX, walls.len())));
-    }
-    Ok(walls)
-}
-
-type Segment = ([f64; 2], [f64; 2]);
-
-/// The plates of one baffle entry as (index, segment, half-thickness).
-fn baffle_segments(
-    c: &Checker,
-    baffle: &BaffleSpec,
-    drum_radius_m: f64,
-    key: &dyn Fn(&str) -> String,
-) -> Result<Vec<(usize, Segment, f64)>, ConfigError> {
-    let mut out = Vec::new();
-    match *baffle {
-        BaffleSpec::Traditional {
-            count,
-            length_m,
-            half_thickness_m,
-            tilt_deg,
-        } => {
-            c.positive(&key("length_m"), length_m)?;
-            c.positive(&key("half_thickness_m"), half_thickness_m)?;
-            if count == 0 {
-                return Err(c.fail(key("count"), "expected at least 1"));
-            }
-            if length_m >= drum_radius_m {
-                return Err(c.fail(
-                    key("length_m"),
-                    format!("a wall baffle must be shorter than the drum radius {drum_radius_m} m"),
-                ));
-            }
-            if !(tilt_deg.is_finite() && tilt_deg.abs() < 80.0) {
-                return Err(c.fail(key("tilt_deg"), format!("expected |tilt| < 80°, got {tilt_deg}")));
-            }
-            let tilt = tilt_deg.to_radians();
-            for k in 0..count as usize {
-                let phi = 2.0 * PI * k as f64 / count as f64;
-                let base = [drum_radius_m * phi.cos(), drum_radius_m * phi.sin()];
-                // Inward radial direction turned by the tilt.
-                let dir_angle = phi + PI + tilt;
-                let tip = [
-                    base[0] + length_m * dir_angle.cos(),
-                    base[1] + length_m * dir_angle.sin(),
-                ];
-                out.push((k, (base, tip), half_thickness_m));
-            }
-        }
-        BaffleSpec::Axial {
-            count,
-            length_m,
-            half_thickness_m,
-            inner_radius_m,
-        } => {
-            c.positive(&key("length_m"), length_m)?;
-            c.positive(&key("half_thickness_m"), half_thickness_m)?;
-            c.non_negative(&key("inner_radius_m"), inner_radius_m)?;
-            if count == 0 {
-                return Err(c.fail(key("count"), "expected at least 1"));
-            }
-            // CHOICE: seed 000 shows the axial baffles only in Fig. 23, whose geometry the text does not give.
-            // One plate is a bar centred on the axis; several are spokes from inner_radius_m outwards.
-            if count == 1 {
-                let h = 0.5 * length_m;
-                if h >= drum_radius_m {
-                    return Err(c.fail(key("length_m"), "the axial bar must fit inside the drum"));
-                }
-                out.push((0, ([-h, 0.0], [h, 0.0]), half_thickness_m));
-            } else {
-                if inner_radius_m + length_m >= drum_radius_m {
-                    return Err(c.fail(
-                        key("length_m"),
-                        "inner_radius_m + length_m must be less than the drum radius",
-                    ));
-                }
-                for k in 0..count as usize {
-                    let phi = 2.0 * PI * k as f64 / count as f64;
-                    let (s, co) = phi.sin_cos();
-                    let a = [inner_radius_m * co, inner_radius_m * s];
-                    let b = [(inner_radius_m + length_m) * co, (inner_radius_m + length_m) * s];
-                    out.push((k, (a, b), half_thickness_m));
-                }
-            }
-        }
-        BaffleSpec::Segment {
-            start_m,
-            end_m,
-            half_thickness_m,
-        } => {
-            c.positive(&key("half_thickness_m"), half_thickness_m)?;
-            if !start_m.iter().chain(&end_m).all(|v| v.is_finite()) {
-                return Err(c.fail(key("start_m"), "expected finite coordinates"));
-            }
-            out.push((0, (start_m, end_m), half_thickness_m));
-        }
-    }
-    Ok(out)
 }
 
 /// The most points a lattice fill may enumerate (most fall outside a drum or are cut by walls, so this is larger

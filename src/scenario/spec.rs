@@ -383,6 +383,21 @@ pub struct DrumSpec {
     pub rotation_rpm: f64,
     #[serde(default)]
     pub baffles: Vec<BaffleSpec>,
+    /// Beads glued to the inside of the drum, turning with it: a rough wall (seed 000 §3.4 builds its tumbler wall
+    /// from particles). Without them the wall is a smooth cylinder, on which a bed of free-rolling spheres slides.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub glued_beads: Option<GluedBeadsSpec>,
+}
+
+/// Spheres of `radius_m` centred on the drum's surface, `count_around` of them equally spaced around it (even) in
+/// rings `axial_spacing_m` apart along the axis (from the axis point; along a periodic axis an even number of rings
+/// per period). A bead contact is a wall contact (the bead does not move but with the drum).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, schemars::JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct GluedBeadsSpec {
+    pub radius_m: f64,
+    pub count_around: u32,
+    pub axial_spacing_m: f64,
 }
 
 /// Baffle plates fixed to a drum (seed 000 §3.4, Fig. 23). Coordinates are in the plane normal to the drum axis,
@@ -474,6 +489,15 @@ impl FillSpec {
             FillSpec::Lattice { temperature_k, .. }
             | FillSpec::Explicit { temperature_k, .. }
             | FillSpec::Random { temperature_k, .. } => *temperature_k,
+        }
+    }
+
+    /// The species it places.
+    pub fn species(&self) -> &str {
+        match self {
+            FillSpec::Lattice { species, .. } | FillSpec::Explicit { species, .. } | FillSpec::Random { species, .. } => {
+                species
+            }
         }
     }
 

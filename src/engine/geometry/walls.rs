@@ -71,6 +71,26 @@ pub enum WallShape {
         end_m: [f64; 2],
         half_thickness_m: f64,
     },
+    /// One of four interleaved sub-lattices of spheres (radius `bead_radius_m`) glued to the inside of a cylinder of
+    /// radius `radius_m` turning with `frame`: centres on the cylinder at body angles 2πk/`count_around` and at
+    /// j·`axial_spacing_m` along the axis from the axis point, for k ≡ `parity[0]` and j ≡ `parity[1]` (mod 2).
+    /// A particle sees the nearest bead of the sub-lattice; the scenario keeps same-parity beads far enough apart
+    /// that it never touches two (seed 000 §3.4's wall of glued particles).
+    GluedBeads {
+        frame: RotatingFrame,
+        radius_m: f64,
+        bead_radius_m: f64,
+        count_around: u32,
+        axial_spacing_m: f64,
+        parity: [u8; 2],
+    },
+}
+
+/// The integer nearest to `t` whose parity is `parity` (0 even, 1 odd), as a float.
+#[inline]
+fn nearest_with_parity(t: f64, parity: u8) -> f64 {
+    let p = f64::from(parity);
+    2.0 * ((t - p) * 0.5).round() + p
 }
 
 #[derive(Debug, Clone, PartialEq)]
@@ -109,9 +129,9 @@ impl Wall {
     pub fn angular_velocity_rad_per_s(&self) -> f64 {
         match &self.shape {
             WallShape::Plane { .. } => 0.0,
-            WallShape::RotatingCylinder { frame, .. } | WallShape::Baffle { frame, .. } => {
-                frame.angular_velocity_rad_per_s
-            }
+            WallShape::RotatingCylinder { frame, .. }
+            | WallShape::Baffle { frame, .. }
+            | WallShape::GluedBeads { frame, .. } => frame.angular_velocity_rad_per_s,
         }
     }
 
@@ -130,6 +150,9 @@ impl Wall {
                 let r1 = (end_m[0].powi(2) + end_m[1].powi(2)).sqrt();
                 r0.max(r1) + half_thickness_m
             }
+            WallShape::GluedBeads {
+                radius_m, bead_radius_m, ..
+            } => radius_m + bead_radius_m,
         }
     }
 
@@ -185,6 +208,35 @@ impl Wall {
                     wall_angular_velocity: frame.axis * frame.angular_velocity_rad_per_s,
                 }
             }
+            WallShape::GluedBeads {
+                frame,
+                radius_m,
+                bead_radius_m,
+                count_around,
+                axial_spacing_m,
+                parity,
+            } => {
+                let (u, v) = frame.body_coordinates(x, angle_rad);
+                let step_rad = 2.0 * std::f64::consts::PI / f64::from(*count_around);
+                let theta = nearest_with_parity(v.atan2(u) / step_rad, parity[0]) * step_rad;
+                let axial_m = (x - frame.axis_point_m).dot(&frame.axis);
+                let ring_m = nearest_with_parity(axial_m / axial_spacing_m, parity[1]) * axial_spacing_m;
+                let (s, co) = theta.sin_cos();
+                let centre = frame.axis_point_m
+                    + frame.axis * ring_m
+                    + frame.world_vector(radius_m * co, radius_m * s, angle_rad);
+                let d = x - centre;
+                let dist = d.norm();
+                // A centre on the bead's own centre: push it inwards, towards the axis.
+                let normal = if dist > 0.0 { d / dist } else { -frame.world_vector(co, s, angle_rad) };
+                let contact_point = centre + normal * *bead_radius_m;
+                WallProximity {
+                    gap_m: dist - bead_radius_m,
+                    normal,
+                    wall_velocity: frame.velocity_at(&contact_point),
+                    wall_angular_velocity: frame.axis * frame.angular_velocity_rad_per_s,
+                }
+            }
         }
     }
 }
@@ -206,6 +258,46 @@ mod tests {
         assert!((p.normal - Vec3::new(0.0, 1.0, 0.0)).norm() < 1e-12);
         // Ω ẑ × (0, −1, 0.3) = (2, 0, 0): the bottom moves towards +x for counter-clockwise rotation.
         assert!((p.wall_velocity - Vec3::new(2.0, 0.0, 0.0)).norm() < 1e-12);
+    }
+
+    /// The four sub-lattices together are the whole bead lattice: the nearest of their beads is the nearest bead,
+    /// which turns with the drum and moves at Ω × the contact point.
+    #[test]
+    fn glued_beads_are_the_nearest_bead_of_each_sub_lattice() {
+        let frame = RotatingFrame::new(Vec3::zeros(), Vec3::z(), 2.0);
+        let lattice: Vec<Wall> = (0..4u8)
+            .map(|p| Wall {
+                name: format!("beads_{p}"),
+                species: SpeciesId(0),
+                shape: WallShape::GluedBeads {
+                    frame,
+                    radius_m: 1.0,
+                    bead_radius_m: 0.05,
+                    count_around: 36,
+                    axial_spacing_m: 0.2,
+                    parity: [p / 2, p % 2],
+                },
+            })
+            .collect();
+        let step = 2.0 * std::f64::consts::PI / 36.0;
+        // Beside bead k = 3 (odd), ring j = 2 (even), at angle 0: 0.1 m inwards from its centre.
+        let bead = Vec3::new((3.0 * step).cos(), (3.0 * step).sin(), 0.4);
+        let x = bead * 0.9 + Vec3::new(0.0, 0.0, 0.04);
+        let gaps: Vec<f64> = lattice.iter().map(|w| w.proximity(&x, 0.0).gap_m).collect();
+        let inward = bead - Vec3::new(0.0, 0.0, 0.4);
+        let expected = (inward * 0.1).norm().hypot(0.04) - 0.05;
+        assert!((gaps[2] - expected).abs() < 1e-12, "{gaps:?}");
+        assert!(gaps.iter().enumerate().all(|(p, &g)| p == 2 || g > gaps[2]));
+        let p = lattice[2].proximity(&x, 0.0);
+        let contact = x - p.normal * (p.gap_m);
+        assert!((p.wall_velocity - Vec3::new(-2.0 * contact.y, 2.0 * contact.x, 0.0)).norm() < 1e-12);
+        // Turned by one step, bead k = 3 sits where k = 4 sat: a point there sees it again, now through parity 1.
+        let turned = Vec3::new((4.0 * step).cos(), (4.0 * step).sin(), 0.4) * 0.9 + Vec3::new(0.0, 0.0, 0.04);
+        assert!((lattice[2].proximity(&turned, step).gap_m - expected).abs() < 1e-12);
+        // Across the angle ±π and along the axis the lattice continues: bead k = 18 ≡ −18 at angle π.
+        let far = Vec3::new(-0.9, 1e-9, -0.4 + 0.04);
+        let g = lattice[0].proximity(&far, 0.0).gap_m;
+        assert!((g - (0.1f64.hypot(0.04) - 0.05)).abs() < 1e-9, "{g}");
     }
 
     #[test]
