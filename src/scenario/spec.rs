@@ -495,9 +495,9 @@ impl FillSpec {
     /// The species it places.
     pub fn species(&self) -> &str {
         match self {
-            FillSpec::Lattice { species, .. } | FillSpec::Explicit { species, .. } | FillSpec::Random { species, .. } => {
-                species
-            }
+            FillSpec::Lattice { species, .. }
+            | FillSpec::Explicit { species, .. }
+            | FillSpec::Random { species, .. } => species,
         }
     }
 

@@ -151,7 +151,9 @@ impl Wall {
                 r0.max(r1) + half_thickness_m
             }
             WallShape::GluedBeads {
-                radius_m, bead_radius_m, ..
+                radius_m,
+                bead_radius_m,
+                ..
             } => radius_m + bead_radius_m,
         }
     }
@@ -228,7 +230,11 @@ impl Wall {
                 let d = x - centre;
                 let dist = d.norm();
                 // A centre on the bead's own centre: push it inwards, towards the axis.
-                let normal = if dist > 0.0 { d / dist } else { -frame.world_vector(co, s, angle_rad) };
+                let normal = if dist > 0.0 {
+                    d / dist
+                } else {
+                    -frame.world_vector(co, s, angle_rad)
+                };
                 let contact_point = centre + normal * *bead_radius_m;
                 WallProximity {
                     gap_m: dist - bead_radius_m,
@@ -280,20 +286,21 @@ mod tests {
             })
             .collect();
         let step = 2.0 * std::f64::consts::PI / 36.0;
-        // Beside bead k = 3 (odd), ring j = 2 (even), at angle 0: 0.1 m inwards from its centre.
-        let bead = Vec3::new((3.0 * step).cos(), (3.0 * step).sin(), 0.4);
-        let x = bead * 0.9 + Vec3::new(0.0, 0.0, 0.04);
+        // Beside bead k = 3 (odd), ring j = 2 (even), at angle 0: 0.1 m inwards and 0.04 m along the axis from its
+        // centre.
+        let at =
+            |k: f64, radial: f64, axial: f64| Vec3::new(radial * (k * step).cos(), radial * (k * step).sin(), axial);
+        let x = at(3.0, 0.9, 0.44);
         let gaps: Vec<f64> = lattice.iter().map(|w| w.proximity(&x, 0.0).gap_m).collect();
-        let inward = bead - Vec3::new(0.0, 0.0, 0.4);
-        let expected = (inward * 0.1).norm().hypot(0.04) - 0.05;
+        let expected = 0.1f64.hypot(0.04) - 0.05;
         assert!((gaps[2] - expected).abs() < 1e-12, "{gaps:?}");
         assert!(gaps.iter().enumerate().all(|(p, &g)| p == 2 || g > gaps[2]));
         let p = lattice[2].proximity(&x, 0.0);
-        let contact = x - p.normal * (p.gap_m);
+        let contact = x - p.normal * p.gap_m;
+        assert!((contact - at(3.0, 1.0, 0.4)).norm() - 0.05 < 1e-12);
         assert!((p.wall_velocity - Vec3::new(-2.0 * contact.y, 2.0 * contact.x, 0.0)).norm() < 1e-12);
-        // Turned by one step, bead k = 3 sits where k = 4 sat: a point there sees it again, now through parity 1.
-        let turned = Vec3::new((4.0 * step).cos(), (4.0 * step).sin(), 0.4) * 0.9 + Vec3::new(0.0, 0.0, 0.04);
-        assert!((lattice[2].proximity(&turned, step).gap_m - expected).abs() < 1e-12);
+        // Turned by one step, bead k = 3 sits where k = 4 sat: a point there sees it again.
+        assert!((lattice[2].proximity(&at(4.0, 0.9, 0.44), step).gap_m - expected).abs() < 1e-12);
         // Across the angle ±π and along the axis the lattice continues: bead k = 18 ≡ −18 at angle π.
         let far = Vec3::new(-0.9, 1e-9, -0.4 + 0.04);
         let g = lattice[0].proximity(&far, 0.0).gap_m;

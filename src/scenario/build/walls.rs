@@ -232,7 +232,6 @@ fn baffle_segments(
     Ok(out)
 }
 
-
 /// The four interleaved sub-lattices of a drum's glued beads, as walls `<drum>_beads_<k parity><j parity>`.
 ///
 /// Seed 000 §3.4 builds its tumbler wall from particles "loaded along a cylindrical geometry": a bumpy wall on
@@ -258,13 +257,19 @@ fn glued_bead_walls(
     if beads.radius_m >= 0.5 * d.radius_m {
         return Err(c.fail(
             key("radius_m"),
-            format!("expected a bead radius below half the drum radius {} m, got {} m", d.radius_m, beads.radius_m),
+            format!(
+                "expected a bead radius below half the drum radius {} m, got {} m",
+                d.radius_m, beads.radius_m
+            ),
         ));
     }
     if beads.count_around < 4 || beads.count_around % 2 != 0 {
         return Err(c.fail(
             key("count_around"),
-            format!("expected an even number of beads around the drum, at least 4, got {}", beads.count_around),
+            format!(
+                "expected an even number of beads around the drum, at least 4, got {}",
+                beads.count_around
+            ),
         ));
     }
     // The largest particle the fills place: a particle may touch one bead of each sub-lattice only.

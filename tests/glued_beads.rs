@@ -1,0 +1,133 @@
+//! Glued beads on a drum (`walls[].drum.glued_beads`, seed 000 §3.4's wall "created by loading the particles along
+//! a cylindrical geometry"): a drum slice of 3 mm beads turning at 6 rpm, once with a smooth wall and once with 40
+//! beads glued around it. On the smooth wall the outer layer turns like the balls of a bearing — spinning at about
+//! R/(2a) times the drum's rate while its centres lag at about half the wall's speed — and the bed does not lift; on
+//! the beads the outer layer turns with the drum as a solid body. A run with beads resumes bit for bit on another
+//! thread count, and impossible bead lattices are bad input at their key.
+
+mod common;
+
+use common::{built, granflow, granflow_fails_with_2, simulation, whole_and_resumed};
+use granflow::engine::state::first_difference;
+
+const RPM: f64 = 6.0;
+const DRUM_RADIUS_M: f64 = 0.02;
+
+/// A drum slice 20 mm in radius, two bead layers deep (6.3 mm, periodic), half filled from a lattice; `beads` is
+/// the drum's extra YAML (empty for a smooth wall).
+fn drum(beads: &str, end_time_s: f64) -> String {
+    format!(
+        r#"name: glued-beads
+domain: {{ lo_m: [-0.021, -0.021, 0.0], hi_m: [0.021, 0.021, 0.0063], periodic: [false, false, true] }}
+gravity: {{ vector_m_per_s2: [0.0, -9.81, 0.0] }}
+species:
+  - {{ name: glass, radius_m: 0.0015, density_kg_per_m3: 2500.0, youngs_modulus_pa: 1.0e6, poisson_ratio: 0.3, friction_coefficient: 0.4 }}
+  - {{ name: wall, radius_m: 0.0015, density_kg_per_m3: 2500.0, youngs_modulus_pa: 1.0e6, poisson_ratio: 0.3, friction_coefficient: 1.0 }}
+contact: {{ normal: {{ hertz: {{ restitution: 0.9 }} }}, tangential: mindlin }}
+walls:
+  - drum: {{ name: drum, species: wall, axis_point_m: [0.0, 0.0, 0.0], axis: [0.0, 0.0, 1.0], radius_m: {DRUM_RADIUS_M}, rotation_rpm: {RPM}{beads} }}
+fill:
+  - lattice: {{ species: glass, spacing_m: 0.00315, lo_m: [-0.02, -0.02, 0.0], hi_m: [0.02, 0.005, 0.0063], origin_m: [0.001575, 0.0, 0.001575], inside_drum: drum }}
+time: {{ dt_fraction_of_contact_time: 0.05, end_time_s: {end_time_s} }}
+output: {{ series_every_steps: 2000, checkpoint_every_steps: 1000 }}
+seed: 1
+"#
+    )
+}
+
+const BEADS: &str = ", glued_beads: { radius_m: 0.0015, count_around: 40, axial_spacing_m: 0.00315 }";
+
+/// (v_x / (Ω R), spin / Ω) of the particles in the bottom of the drum (below −0.6 R) within 2.5 mm of its wall,
+/// after `end_time_s`.
+fn wall_layer(beads: &str, end_time_s: f64) -> (f64, f64, usize) {
+    let b = built(&drum(beads, end_time_s));
+    let mut sim = simulation(&b, 1);
+    let steps = (end_time_s / b.dt_s).round() as u64;
+    sim.run_steps(steps).expect("runs");
+    let s = sim.snapshot();
+    let omega = RPM * 2.0 * std::f64::consts::PI / 60.0;
+    let p = &s.particles;
+    let (mut vx, mut spin, mut n) = (0.0, 0.0, 0usize);
+    for i in 0..p.position_m.len() {
+        let x = p.position_m[i];
+        if x.y < -0.6 * DRUM_RADIUS_M && x.x.hypot(x.y) > DRUM_RADIUS_M - 0.0025 {
+            vx += p.velocity_m_per_s[i].x;
+            spin += p.angular_velocity_rad_per_s[i].z;
+            n += 1;
+        }
+    }
+    assert!(n > 5, "only {n} particles at the bottom of the wall");
+    (vx / n as f64 / (omega * DRUM_RADIUS_M), spin / n as f64 / omega, n)
+}
+
+#[test]
+fn glued_beads_turn_the_bed_with_the_drum_where_a_smooth_wall_lets_it_roll() {
+    let (smooth_speed, smooth_spin, _) = wall_layer("", 4.0);
+    let (rough_speed, rough_spin, n) = wall_layer(BEADS, 4.0);
+    // Measured: smooth -0.46 and 21 (the layer rolls, the bed above it slides back); beads 0.79 and 1.0 (a
+    // particle resting on the beads has its centre at about 0.82 R).
+    assert!(
+        smooth_spin > 5.0,
+        "smooth wall: spin/Ω = {smooth_spin}, v/(ΩR) = {smooth_speed}"
+    );
+    assert!(smooth_speed < 0.6, "smooth wall: v/(ΩR) = {smooth_speed}");
+    assert!(
+        (0.65..=0.95).contains(&rough_speed) && (0.5..=1.5).contains(&rough_spin),
+        "beads: v/(ΩR) = {rough_speed}, spin/Ω = {rough_spin} over {n} particles"
+    );
+}
+
+#[test]
+fn a_drum_with_glued_beads_resumes_bit_for_bit() {
+    let tmp = tempfile::tempdir().unwrap();
+    let (whole, split) = whole_and_resumed(tmp.path(), &drum(BEADS, 0.1), 1700);
+    if let Some(diff) = first_difference(&whole, &split) {
+        panic!("the resumed run differs from the uninterrupted one: {diff}");
+    }
+}
+
+#[test]
+fn impossible_bead_lattices_are_bad_input_at_their_key() {
+    let tmp = tempfile::tempdir().unwrap();
+    let cases = [
+        (
+            ", glued_beads: { radius_m: 0.0015, count_around: 41, axial_spacing_m: 0.00315 }",
+            "walls[0].drum.glued_beads.count_around",
+            "expected an even number",
+        ),
+        // 2 R sin(2π/44) = 5.7 mm between every other bead: a 3 mm particle could touch two.
+        (
+            ", glued_beads: { radius_m: 0.0015, count_around: 44, axial_spacing_m: 0.00315 }",
+            "walls[0].drum.glued_beads.count_around",
+            "at most 40",
+        ),
+        (
+            ", glued_beads: { radius_m: 0.0015, count_around: 40, axial_spacing_m: 0.0021 }",
+            "walls[0].drum.glued_beads.axial_spacing_m",
+            "between rings",
+        ),
+        (
+            ", glued_beads: { radius_m: 0.0015, count_around: 40, axial_spacing_m: 0.0063 }",
+            "walls[0].drum.glued_beads.axial_spacing_m",
+            "an even number of rings",
+        ),
+        (
+            ", glued_beads: { radius_m: -0.0015, count_around: 40, axial_spacing_m: 0.00315 }",
+            "walls[0].drum.glued_beads.radius_m",
+            "expected a finite value > 0",
+        ),
+    ];
+    for (k, (beads, key, message)) in cases.iter().enumerate() {
+        let file = format!("bad-{k}.yaml");
+        std::fs::write(tmp.path().join(&file), drum(beads, 0.01)).unwrap();
+        granflow_fails_with_2(&["simulate", &file, "--out", "out", "--quiet"], tmp.path(), key);
+        let out = granflow(&["simulate", &file, "--out", "out", "--quiet"], tmp.path());
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert!(stderr.contains(message), "case {k}: expected `{message}` in {stderr}");
+        assert!(
+            stderr.contains(&format!("{file}:")),
+            "case {k}: no file and line in {stderr}"
+        );
+        assert!(!tmp.path().join("out").exists(), "case {k}: wrote output");
+    }
+}
