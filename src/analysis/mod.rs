@@ -11,6 +11,8 @@
 //! - `escape_velocity`: the head-on escape velocity of a Hamaker pair and the Hamaker constant matching a square
 //!   well (seed 001 ch. 7).
 //! - `drying_curve`: the drying curve's times to 50 % and 90 % dried and its constant-rate period (seed 000 §7.3).
+//! - `shear_profile`: the shear rate of a chute flow from its layer-averaged velocity profile and the critical flip
+//!   frequency of seed 000's zig-zag chute (§3.2, eqs 3.4-3.5).
 //! - `wall_heat`: the wall-to-bed heat transfer coefficient h_w of a heated drum, its core temperature and contact
 //!   arc (seed 000 §5.2.4).
 //!
@@ -25,6 +27,7 @@ pub mod fluidization;
 pub mod granular;
 pub mod knn;
 pub mod mixing;
+pub mod shear_profile;
 pub mod wall_heat;
 
 pub use fit::{ExponentialFit, fit_exponential_decay, time_to_fraction_of_max};

@@ -86,6 +86,14 @@ job_metrics! {
         "IS averaged over the mixing samples from analysis.average_from_s: the asymptotic state's segregation that seed 000 §4.2.2 compares wet against dry (Figs 52-53)";
     TimeTo90PctMaxLacey => "time_to_90pct_max_lacey_s", "s", [MixingSpecies],
         "first time the Lacey index reaches 90 % of its maximum (seed 000 Table 1)";
+    ShearRate => "shear_rate_per_s", "1/s", [],
+        "the steepest shear rate between neighbouring dense layers (one largest diameter thick) of the layer-averaged velocity along the flow, averaged over the series from analysis.average_from_s (seed 000 eq. 3.4, Figs 13 and 15c; also a series column); heights along the axis gravity is most along";
+    CriticalFlipFrequency => "critical_flip_frequency_hz", "Hz", [TwoSpecies],
+        "f_crit = 0.01 beta shear_rate (1 - rho_light/rho_heavy) (seed 000 eq. 3.5), beta = analysis.segregation_beta (default 0.1, the seed's fit)";
+    FlipFrequencyRatio => "flip_frequency_ratio", "1", [TwoSpecies, GravityFlip],
+        "the gravity flip frequency over f_crit (seed 000 Fig. 19's axis): above 1 the flips should outrun segregation";
+    FlipRuleAgreement => "flip_rule_agreement", "1", [MixingSpecies, TwoSpecies, GravityFlip],
+        "(IS - 0.25) sign(1 - f/f_crit) at the end: positive when the job lies on the side of seed 000 Fig. 19's rule its f/f_crit predicts (IS > 0.25 below f_crit, < 0.25 above), its size the margin";
     HeightMixingIndex => "height_mixing_index", "1", [],
         "seed 001's mixing index (§7.2.2) at the last series row: mean height of the particles that were at or above the bed's median height at analysis.height_families_at_s over that of the rest, heights from the domain's floor along -gravity; 3 segregated, 1 mixed (also a series column)";
     MeanHeightTimeAverage => "mean_height_time_avg_m", "m", [],
@@ -256,6 +264,8 @@ pub enum Need {
     HeatedDrum,
     /// A `drying` section.
     Drying,
+    /// Gravity with a flipping component (`gravity.flip`).
+    GravityFlip,
 }
 
 impl Need {
@@ -274,6 +284,7 @@ impl Need {
             Need::Heat => "heat transfer",
             Need::HeatedDrum => "a heated drum",
             Need::Drying => "drying",
+            Need::GravityFlip => "gravity.flip",
         }
     }
 
@@ -330,6 +341,10 @@ impl Need {
             Need::Drying => unless(
                 scenario.drying.is_some(),
                 format!("`{name}` needs drying (a `drying:` section in the scenario)"),
+            ),
+            Need::GravityFlip => unless(
+                scenario.gravity.flip.is_some(),
+                format!("`{name}` needs a flipping gravity (`gravity: {{ ..., flip: {{ axis, frequency_hz }} }}`)"),
             ),
             Need::HeatedDrum => {
                 let heated = scenario.heat.as_ref().map_or(0, |heat| {
@@ -403,6 +418,14 @@ pub fn check(spec: &CampaignSpec) -> Result<Vec<JobMetric>, (String, String)> {
                 ),
             ));
         }
+    }
+    if let Some(beta) = a.segregation_beta
+        && !(beta.is_finite() && beta > 0.0)
+    {
+        return Err((
+            "analysis.segregation_beta".into(),
+            format!("expected a finite value > 0, got {beta}"),
+        ));
     }
     if spec.analysis.mixing_neighbours == 0 {
         return Err(("analysis.mixing_neighbours".into(), "expected at least 1".into()));

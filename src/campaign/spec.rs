@@ -157,6 +157,10 @@ pub struct AnalysisSpec {
     /// data achieved over 1 second show a linear correlation").
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub coating_fit_from_s: Option<f64>,
+    /// β of seed 000's critical flip frequency (eq. 3.5, `critical_flip_frequency_hz`): the segregation Péclet
+    /// number over (1 − ρ̄), "a fitting parameter" (default 0.1, the value the seed fits for its chute, Fig. 19).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub segregation_beta: Option<f64>,
 }
 
 /// The pressure drop of the cycle metrics; see [`AnalysisSpec::cycle_pressure`].
@@ -193,6 +197,7 @@ impl Default for AnalysisSpec {
             heating_fit_from_s: None,
             height_families_at_s: None,
             coating_fit_from_s: None,
+            segregation_beta: None,
         }
     }
 }

@@ -366,6 +366,9 @@ pub enum WallSpec {
         point_m: [f64; 3],
         /// Points into the particle side; normalised on load.
         normal: [f64; 3],
+        /// Beads glued to the plane: a rough floor or roof (seed 000 §3.2's "particle-roughened walls").
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        glued_beads: Option<PlaneBeadsSpec>,
     },
     /// Inside of a rotating cylinder, with baffles turning with it.
     Drum(DrumSpec),
@@ -387,6 +390,16 @@ pub struct DrumSpec {
     /// from particles). Without them the wall is a smooth cylinder, on which a bed of free-rolling spheres slides.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub glued_beads: Option<GluedBeadsSpec>,
+}
+
+/// Spheres of `radius_m` centred on a plane at `point_m + i·spacing_m[0]·e1 + j·spacing_m[1]·e2` for all integers i,
+/// j, where e1 is the first of x, y, z not along the normal made normal to it and e2 = normal × e1 (for a floor of
+/// normal +y: e1 = x, e2 = −z). Along a periodic axis an even number of beads per period.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, schemars::JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct PlaneBeadsSpec {
+    pub radius_m: f64,
+    pub spacing_m: [f64; 2],
 }
 
 /// Spheres of `radius_m` centred on the drum's surface, `count_around` of them equally spaced around it (even) in

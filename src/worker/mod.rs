@@ -16,6 +16,7 @@ pub mod protocol;
 pub(crate) mod reduce;
 pub mod rereduce;
 mod series_h5;
+mod shear_column;
 
 use std::fs::File;
 use std::io::{Read, Write};
@@ -245,6 +246,8 @@ struct WorkerObserver {
     total_steps: u64,
     mixing: Option<reduce::MixingSampler>,
     heights: Option<height_families::HeightFamilies>,
+    /// The shear-rate column (`shear_column`), when a metric reads it.
+    shear: bool,
     /// What stopped a sampler (its families file could not be written): the job fails with it after the run.
     failure: Option<Error>,
     /// False while running a shared preparation: its progress is the job's heartbeat, but the job has not started.
@@ -258,6 +261,7 @@ impl WorkerObserver {
             total_steps: 0,
             mixing: reduce::MixingSampler::new(job, built),
             heights: height_families::HeightFamilies::new(job, Some(dir))?,
+            shear: shear_column::wanted(job),
             failure: None,
             announce_start: true,
         })
@@ -270,6 +274,7 @@ impl WorkerObserver {
             total_steps: 0,
             mixing: reduce::MixingSampler::new(job, built),
             heights: height_families::HeightFamilies::new(job, None).ok().flatten(),
+            shear: shear_column::wanted(job),
             failure: None,
             announce_start: false,
         }
@@ -284,6 +289,9 @@ impl RunObserver for WorkerObserver {
         };
         if self.heights.is_some() {
             columns += &format!(",{}", height_families::COLUMN);
+        }
+        if self.shear {
+            columns += &format!(",{}", shear_column::COLUMN);
         }
         columns
     }
@@ -301,6 +309,9 @@ impl RunObserver for WorkerObserver {
                     self.failure.get_or_insert(e);
                 }
             }
+        }
+        if self.shear {
+            row += &shear_column::row(sim);
         }
         row
     }

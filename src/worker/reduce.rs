@@ -155,6 +155,23 @@ pub fn metrics(job: &JobSpec, built: &BuiltScenario, sim: &Simulation, series: &
         ))
     };
     let average_from_s = job.analysis.average_from_s.unwrap_or(0.5 * built.spec.time.end_time_s);
+    // The chute's shear rate (the series column's mean from average_from_s) and seed 000's f_crit (eq. 3.5) with
+    // the density ratio of the two species, light over heavy.
+    let shear_rate = || window(series, "shear_rate_per_s", average_from_s).map_or(f64::NAN, |w| mean(&w));
+    let critical_frequency = || {
+        // The species the particles are of (a wall's species places none).
+        let (light, heavy) = sim
+            .particles
+            .species
+            .iter()
+            .map(|s| built.config.species.species[s.index()].density_kg_per_m3)
+            .fold((f64::INFINITY, 0.0_f64), |(lo, hi), d| (lo.min(d), hi.max(d)));
+        analysis::shear_profile::critical_flip_frequency_hz(
+            job.analysis.segregation_beta.unwrap_or(0.1),
+            shear_rate(),
+            light / heavy,
+        )
+    };
     // The cycle is read once for all the cycle metrics that ask for it.
     let cycle_once = std::cell::OnceCell::new();
     let cycle = || cycle_once.get_or_init(|| cycle(job, built, sim, series)).as_ref();
@@ -231,6 +248,28 @@ pub fn metrics(job: &JobSpec, built: &BuiltScenario, sim: &Simulation, series: &
                     mixing_series()
                         .and_then(|(t, is, _)| analysis::fit::fit_exponential_decay_to(&t, &is, random))
                         .map_or(f64::NAN, |f| f.rate_constant_per_s)
+                }
+                JobMetric::ShearRate => shear_rate(),
+                JobMetric::CriticalFlipFrequency => critical_frequency(),
+                JobMetric::FlipFrequencyRatio => built
+                    .spec
+                    .gravity
+                    .flip
+                    .as_ref()
+                    .map_or(f64::NAN, |flip| flip.frequency_hz / critical_frequency()),
+                JobMetric::FlipRuleAgreement => {
+                    let ratio = built
+                        .spec
+                        .gravity
+                        .flip
+                        .as_ref()
+                        .map_or(f64::NAN, |flip| flip.frequency_hz / critical_frequency());
+                    let is_end = mixing_final.map_or(f64::NAN, |m| m.intensity_of_segregation);
+                    if ratio.is_nan() || ratio == 1.0 {
+                        f64::NAN
+                    } else {
+                        (is_end - 0.25) * (1.0 - ratio).signum()
+                    }
                 }
                 JobMetric::IntensityOfSegregationTimeAverage => {
                     window(series, "intensity_of_segregation", average_from_s).map_or(f64::NAN, |w| mean(&w))

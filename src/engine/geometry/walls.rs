@@ -84,6 +84,18 @@ pub enum WallShape {
         axial_spacing_m: f64,
         parity: [u8; 2],
     },
+    /// One of four interleaved sub-lattices of spheres (radius `bead_radius_m`) glued to a static plane: centres at
+    /// `point_m + i·spacing_m[0]·e1 + j·spacing_m[1]·e2` for i ≡ `parity[0]`, j ≡ `parity[1]` (mod 2); e1, e2 unit
+    /// vectors in the plane. `normal` points to the particle side (seed 000 §3.2's particle-roughened walls).
+    PlaneBeads {
+        point_m: Vec3,
+        normal: Vec3,
+        e1: Vec3,
+        e2: Vec3,
+        bead_radius_m: f64,
+        spacing_m: [f64; 2],
+        parity: [u8; 2],
+    },
 }
 
 /// The integer nearest to `t` whose parity is `parity` (0 even, 1 odd), as a float.
@@ -128,7 +140,7 @@ impl Wall {
     /// Angular velocity of the wall's rotation (0 for static walls).
     pub fn angular_velocity_rad_per_s(&self) -> f64 {
         match &self.shape {
-            WallShape::Plane { .. } => 0.0,
+            WallShape::Plane { .. } | WallShape::PlaneBeads { .. } => 0.0,
             WallShape::RotatingCylinder { frame, .. }
             | WallShape::Baffle { frame, .. }
             | WallShape::GluedBeads { frame, .. } => frame.angular_velocity_rad_per_s,
@@ -139,7 +151,7 @@ impl Wall {
     pub fn max_lever_m(&self) -> f64 {
         match &self.shape {
             // A cylinder's surface moves only tangentially to itself: its gap to any point never changes.
-            WallShape::Plane { .. } | WallShape::RotatingCylinder { .. } => 0.0,
+            WallShape::Plane { .. } | WallShape::RotatingCylinder { .. } | WallShape::PlaneBeads { .. } => 0.0,
             WallShape::Baffle {
                 start_m,
                 end_m,
@@ -208,6 +220,28 @@ impl Wall {
                     normal,
                     wall_velocity: frame.velocity_at(&contact_point),
                     wall_angular_velocity: frame.axis * frame.angular_velocity_rad_per_s,
+                }
+            }
+            WallShape::PlaneBeads {
+                point_m,
+                normal,
+                e1,
+                e2,
+                bead_radius_m,
+                spacing_m,
+                parity,
+            } => {
+                let r = x - point_m;
+                let i = nearest_with_parity(r.dot(e1) / spacing_m[0], parity[0]);
+                let j = nearest_with_parity(r.dot(e2) / spacing_m[1], parity[1]);
+                let centre = point_m + e1 * (i * spacing_m[0]) + e2 * (j * spacing_m[1]);
+                let d = x - centre;
+                let dist = d.norm();
+                WallProximity {
+                    gap_m: dist - bead_radius_m,
+                    normal: if dist > 0.0 { d / dist } else { *normal },
+                    wall_velocity: Vec3::zeros(),
+                    wall_angular_velocity: Vec3::zeros(),
                 }
             }
             WallShape::GluedBeads {
@@ -305,6 +339,37 @@ mod tests {
         let far = Vec3::new(-0.9, 1e-9, -0.4 + 0.04);
         let g = lattice[0].proximity(&far, 0.0).gap_m;
         assert!((g - (0.1f64.hypot(0.04) - 0.05)).abs() < 1e-9, "{g}");
+    }
+
+    /// A floor's four sub-lattices: the nearest of their beads is the nearest bead, straight above it the gap is
+    /// the height less the bead's radius, and the beads do not move.
+    #[test]
+    fn plane_beads_are_the_nearest_bead_of_each_sub_lattice() {
+        let lattice: Vec<Wall> = (0..4u8)
+            .map(|p| Wall {
+                name: format!("floor_beads_{p}"),
+                species: SpeciesId(0),
+                shape: WallShape::PlaneBeads {
+                    point_m: Vec3::new(0.0, 0.1, 0.0),
+                    normal: Vec3::y(),
+                    e1: Vec3::x(),
+                    e2: -Vec3::z(),
+                    bead_radius_m: 0.5,
+                    spacing_m: [1.0, 2.0],
+                    parity: [p / 2, p % 2],
+                },
+            })
+            .collect();
+        // Above bead i = 3 (odd), j = -2 (even: z = +4), 0.3 m off along x, 1.6 m above the plane.
+        let x = Vec3::new(3.3, 1.7, 4.0);
+        let gaps: Vec<f64> = lattice.iter().map(|w| w.proximity(&x, 0.0).gap_m).collect();
+        let expected = 0.3f64.hypot(1.6) - 0.5;
+        assert!((gaps[2] - expected).abs() < 1e-12, "{gaps:?}");
+        assert!(gaps.iter().enumerate().all(|(p, &g)| p == 2 || g > gaps[2]), "{gaps:?}");
+        let p = lattice[2].proximity(&x, 0.0);
+        assert!((p.normal - Vec3::new(0.3, 1.6, 0.0).normalize()).norm() < 1e-12);
+        assert_eq!(p.wall_velocity, Vec3::zeros());
+        assert_eq!(lattice[2].max_lever_m(), 0.0);
     }
 
     #[test]

@@ -1,4 +1,4 @@
-//! The walls of a scenario: the box's planes, named planes, drums with their baffles and glued beads, validated
+//! The walls of a scenario: the box's planes, named planes and drums (with their glued beads; drums with baffles), validated
 //! (each error names the key) and turned into the engine's [`Wall`]s in the order the engine indexes them.
 
 use std::f64::consts::PI;
@@ -8,7 +8,7 @@ use crate::engine::Vec3;
 use crate::engine::geometry::{Domain, RotatingFrame, Wall, WallShape};
 use crate::engine::particles::SpeciesTable;
 use crate::scenario::ConfigError;
-use crate::scenario::spec::{BaffleSpec, DrumSpec, GluedBeadsSpec, ScenarioSpec, WallSpec};
+use crate::scenario::spec::{BaffleSpec, DrumSpec, GluedBeadsSpec, PlaneBeadsSpec, ScenarioSpec, WallSpec};
 
 /// The scenario's walls: per `walls` entry, a box's planes (one per non-periodic face), a plane, or a drum followed
 /// by its glued-bead sub-lattices and its baffle plates.
@@ -44,6 +44,7 @@ pub(super) fn build_walls(
                 species: s,
                 point_m,
                 normal,
+                glued_beads,
             } => {
                 let id = c.species(&format!("walls[{k}].plane.species"), species, s)?;
                 c.finite3(&format!("walls[{k}].plane.point_m"), point_m)?;
@@ -56,6 +57,19 @@ pub(super) fn build_walls(
                         normal: n,
                     },
                 });
+                if let Some(beads) = glued_beads {
+                    walls.extend(plane_bead_walls(
+                        c,
+                        spec,
+                        domain,
+                        k,
+                        name,
+                        Vec3::from(*point_m),
+                        n,
+                        beads,
+                        id,
+                    )?);
+                }
             }
             WallSpec::Drum(d) => {
                 let key = |f: &str| format!("walls[{k}].drum.{f}");
@@ -272,14 +286,7 @@ fn glued_bead_walls(
             ),
         ));
     }
-    // The largest particle the fills place: a particle may touch one bead of each sub-lattice only.
-    let largest_m = spec
-        .fill
-        .iter()
-        .filter_map(|f| spec.species.iter().find(|s| s.name == f.species()))
-        .map(|s| s.radius_m)
-        .fold(0.0_f64, f64::max);
-    let reach_m = beads.radius_m + largest_m;
+    let reach_m = beads.radius_m + largest_fill_radius_m(spec);
     let same_parity_around_m = 2.0 * d.radius_m * (2.0 * PI / f64::from(beads.count_around)).sin();
     if same_parity_around_m < 2.0 * reach_m {
         return Err(c.fail(
@@ -302,33 +309,8 @@ fn glued_bead_walls(
             ),
         ));
     }
-    // Along a periodic axis the rings must repeat with the domain: an even number of rings per period keeps the
-    // sub-lattices' parities across the periodic side.
     let axis = Vec3::from(d.axis).normalize();
-    for a in 0..3 {
-        if !domain.periodic[a] || axis[a].abs() <= 1e-9 {
-            continue;
-        }
-        let axis_name = ["x", "y", "z"][a];
-        if axis[a].abs() < 1.0 - 1e-12 {
-            return Err(c.fail(
-                key("axial_spacing_m"),
-                format!("glued beads need the drum axis along the periodic axis {axis_name} or across it"),
-            ));
-        }
-        let period_m = domain.hi_m[a] - domain.lo_m[a];
-        let rings = period_m / beads.axial_spacing_m;
-        if (rings - rings.round()).abs() > 1e-9 * rings || rings.round() as i64 % 2 != 0 {
-            return Err(c.fail(
-                key("axial_spacing_m"),
-                format!(
-                    "expected an even number of rings in the periodic length {period_m} m along {axis_name}, got \
-                     {rings} rings of {} m",
-                    beads.axial_spacing_m
-                ),
-            ));
-        }
-    }
+    check_periodic_spacing(c, domain, axis, beads.axial_spacing_m, &key("axial_spacing_m"), "rings")?;
     Ok((0..4u8)
         .map(|p| Wall {
             name: format!("{}_beads_{}{}", d.name, p / 2, p % 2),
@@ -350,4 +332,104 @@ fn max_even_count(radius_m: f64, reach_m: f64) -> u32 {
     let ratio = (reach_m / radius_m).min(1.0);
     let n = (2.0 * PI / ratio.asin()).floor() as u32;
     n - n % 2
+}
+
+/// The largest radius of the particles the fills place: a particle may touch only one bead of each sub-lattice.
+fn largest_fill_radius_m(spec: &ScenarioSpec) -> f64 {
+    spec.fill
+        .iter()
+        .filter_map(|f| spec.species.iter().find(|s| s.name == f.species()))
+        .map(|s| s.radius_m)
+        .fold(0.0_f64, f64::max)
+}
+
+/// Along a periodic axis a bead lattice must repeat with the domain, an even number of `what` per period so that the
+/// sub-lattices keep their parities across the periodic side; a lattice direction must then lie along that axis.
+fn check_periodic_spacing(
+    c: &Checker,
+    domain: &Domain,
+    direction: Vec3,
+    spacing_m: f64,
+    key: &str,
+    what: &str,
+) -> Result<(), ConfigError> {
+    for a in 0..3 {
+        if !domain.periodic[a] || direction[a].abs() <= 1e-9 {
+            continue;
+        }
+        let axis_name = ["x", "y", "z"][a];
+        if direction[a].abs() < 1.0 - 1e-12 {
+            return Err(c.fail(
+                key,
+                format!("glued beads along a periodic axis ({axis_name}) need their lattice along it or across it"),
+            ));
+        }
+        let period_m = domain.hi_m[a] - domain.lo_m[a];
+        let count = period_m / spacing_m;
+        if (count - count.round()).abs() > 1e-9 * count || count.round() as i64 % 2 != 0 {
+            return Err(c.fail(
+                key,
+                format!(
+                    "expected an even number of {what} in the periodic length {period_m} m along {axis_name}, got \
+                     {count} {what} of {spacing_m} m"
+                ),
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// The four interleaved sub-lattices of a plane's glued beads, as walls `<plane>_beads_<i parity><j parity>` (seed
+/// 000 §3.2's "particle-roughened walls"; see [`glued_bead_walls`] for why four).
+#[allow(clippy::too_many_arguments)]
+fn plane_bead_walls(
+    c: &Checker,
+    spec: &ScenarioSpec,
+    domain: &Domain,
+    k: usize,
+    name: &str,
+    point_m: Vec3,
+    normal: Vec3,
+    beads: &PlaneBeadsSpec,
+    species: crate::engine::particles::SpeciesId,
+) -> Result<Vec<Wall>, ConfigError> {
+    let key = |f: &str| format!("walls[{k}].plane.glued_beads.{f}");
+    c.positive(&key("radius_m"), beads.radius_m)?;
+    for s in beads.spacing_m {
+        c.positive(&key("spacing_m"), s)?;
+    }
+    let reach_m = beads.radius_m + largest_fill_radius_m(spec);
+    if beads.spacing_m.iter().any(|&s| s < reach_m) {
+        return Err(c.fail(
+            key("spacing_m"),
+            format!(
+                "expected spacings of at least a bead and the largest particle radius ({reach_m} m), got {:?} m",
+                beads.spacing_m
+            ),
+        ));
+    }
+    // e1: the first coordinate axis not along the normal, made normal to it; e2 = normal × e1.
+    let reference = [Vec3::x(), Vec3::y(), Vec3::z()]
+        .into_iter()
+        .find(|a| a.dot(&normal).abs() < 0.9)
+        .expect("a unit normal is along at most one axis");
+    let e1 = (reference - normal * normal.dot(&reference)).normalize();
+    let e2 = normal.cross(&e1);
+    check_periodic_spacing(c, domain, e1, beads.spacing_m[0], &key("spacing_m"), "beads")?;
+    check_periodic_spacing(c, domain, e2, beads.spacing_m[1], &key("spacing_m"), "beads")?;
+    Ok((0..4u8)
+        .map(|p| Wall {
+            name: format!("{name}_beads_{}{}", p / 2, p % 2),
+            species,
+            shape: WallShape::PlaneBeads {
+                point_m,
+                normal,
+                e1,
+                e2,
+                bead_radius_m: beads.radius_m,
+                spacing_m: beads.spacing_m,
+                parity: [p / 2, p % 2],
+            },
+        })
+        .collect())
 }
