@@ -10,7 +10,7 @@ mod common;
 use std::collections::BTreeMap;
 use std::path::Path;
 
-use common::granflow_ok;
+use common::{granflow_ok, only_job_series};
 
 const SPRAY_START_S: f64 = 0.01;
 const FIT_FROM_S: f64 = 0.005;
@@ -41,26 +41,6 @@ metrics: [coating_variability, coating_variability_fit_slope_sqrt_s, coating_var
 analysis: {{ mixing_species: a, mixing_every_steps: 500, average_from_s: {AVERAGE_FROM_S}, coating_fit_from_s: {FIT_FROM_S} }}
 "#
     )
-}
-
-/// The only job's series as columns by name.
-fn series(out: &Path) -> BTreeMap<String, Vec<f64>> {
-    let job = std::fs::read_dir(out.join("jobs"))
-        .unwrap()
-        .next()
-        .unwrap()
-        .unwrap()
-        .path();
-    let text = std::fs::read_to_string(job.join("series.csv")).unwrap();
-    let mut lines = text.lines();
-    let names: Vec<String> = lines.next().unwrap().split(',').map(str::to_string).collect();
-    let mut columns: BTreeMap<String, Vec<f64>> = names.iter().map(|n| (n.clone(), Vec::new())).collect();
-    for line in lines {
-        for (name, field) in names.iter().zip(line.split(',')) {
-            columns.get_mut(name).unwrap().push(field.parse().unwrap());
-        }
-    }
-    columns
 }
 
 fn metrics(out: &Path) -> BTreeMap<String, f64> {
@@ -95,7 +75,7 @@ fn the_coating_line_and_the_time_averaged_segregation_come_from_the_series() {
         &["run", file.to_str().unwrap(), "--out", out.to_str().unwrap(), "--quiet"],
         tmp.path(),
     );
-    let s = series(&out);
+    let s = only_job_series(&out);
     let m = metrics(&out);
     let (t, cv) = (&s["time_s"], &s["coating_variability"]);
     // Before the spray nothing is gained: CV_m is undefined; after it, the sprayed surface stands out.

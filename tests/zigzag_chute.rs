@@ -10,7 +10,7 @@ mod common;
 
 use std::path::Path;
 
-use common::{granflow, granflow_fails_with_2, granflow_ok};
+use common::{granflow, granflow_fails_with_2, granflow_ok, only_job_series};
 
 /// A bed of 2 mm beads, 400 light (1000 kg/m³) and 400 heavy (3000 kg/m³), in a box 16.8 × 8.4 mm periodic along
 /// the flow (x) and across it (z), on a floor of glued beads, under gravity 26° off the floor's normal flipping at
@@ -43,30 +43,6 @@ analysis: {analysis}
 const METRICS: &str = "[shear_rate_per_s, critical_flip_frequency_hz, flip_frequency_ratio, flip_rule_agreement, intensity_of_segregation]";
 const ANALYSIS: &str = "{ mixing_species: light, average_from_s: 0.1, segregation_beta: 0.3 }";
 
-/// (time, shear rate) of the only job's series rows.
-fn shear_rows(out: &Path) -> Vec<(f64, f64)> {
-    let job = std::fs::read_dir(out.join("jobs"))
-        .unwrap()
-        .next()
-        .unwrap()
-        .unwrap()
-        .path();
-    let text = std::fs::read_to_string(job.join("series.csv")).unwrap();
-    let mut lines = text.lines();
-    let header: Vec<&str> = lines.next().unwrap().split(',').collect();
-    let t = header.iter().position(|c| *c == "time_s").unwrap();
-    let g = header
-        .iter()
-        .position(|c| *c == "shear_rate_per_s")
-        .expect("the shear rate column");
-    lines
-        .map(|l| {
-            let f: Vec<&str> = l.split(',').collect();
-            (f[t].parse().unwrap(), f[g].parse().unwrap())
-        })
-        .collect()
-}
-
 fn metric(out: &Path, name: &str) -> f64 {
     let printed = granflow_ok(
         &[
@@ -93,7 +69,12 @@ fn the_shear_rate_column_and_the_critical_frequency_of_eq_3_5() {
     std::fs::write(tmp.path().join("c.yaml"), campaign(0.0021, METRICS, ANALYSIS)).unwrap();
     granflow_ok(&["run", "c.yaml", "--out", "out", "--quiet"], tmp.path());
     let out = tmp.path().join("out");
-    let rows = shear_rows(&out);
+    let series = only_job_series(&out);
+    let rows: Vec<(f64, f64)> = series["time_s"]
+        .iter()
+        .copied()
+        .zip(series["shear_rate_per_s"].iter().copied())
+        .collect();
     let window: Vec<f64> = rows.iter().filter(|(t, _)| *t >= 0.1).map(|&(_, g)| g).collect();
     assert!(
         window.len() > 10 && window.iter().all(|g| g.is_finite() && *g >= 0.0),

@@ -269,3 +269,24 @@ pub fn drum_slice_base(fill_top_m: f64, end_time_s: f64, series_every_steps: u64
 "#
     )
 }
+
+/// The series of a campaign's only job (in `out`) as columns by name.
+pub fn only_job_series(out: &Path) -> std::collections::BTreeMap<String, Vec<f64>> {
+    let job = std::fs::read_dir(out.join("jobs"))
+        .unwrap()
+        .next()
+        .unwrap()
+        .unwrap()
+        .path();
+    let text = std::fs::read_to_string(job.join("series.csv")).unwrap();
+    let mut lines = text.lines();
+    let names: Vec<String> = lines.next().unwrap().split(',').map(str::to_string).collect();
+    let mut columns: std::collections::BTreeMap<String, Vec<f64>> =
+        names.iter().map(|n| (n.clone(), Vec::new())).collect();
+    for line in lines {
+        for (name, field) in names.iter().zip(line.split(',')) {
+            columns.get_mut(name).unwrap().push(field.parse().unwrap());
+        }
+    }
+    columns
+}
