@@ -205,16 +205,9 @@ pub fn wall_heat_transfer_coefficient(t_s: &[f64], core_k: &[f64], inputs: &Wall
     if t.len() < 3 {
         return None;
     }
-    let n = t.len() as f64;
-    let (mt, my) = (t.iter().sum::<f64>() / n, y.iter().sum::<f64>() / n);
-    let stt: f64 = t.iter().map(|t| (t - mt) * (t - mt)).sum();
-    let sty: f64 = t.iter().zip(&y).map(|(t, y)| (t - mt) * (y - my)).sum();
-    let syy: f64 = y.iter().map(|y| (y - my) * (y - my)).sum();
-    if stt <= 0.0 {
-        return None;
-    }
-    let slope = sty / stt;
-    let r_squared = if syy > 0.0 { sty * sty / (stt * syy) } else { 1.0 };
+    // The line's arithmetic is `fit_line`'s (the same sums in the same order).
+    let line = super::fit::fit_line(&t, &y)?;
+    let (slope, r_squared) = (line.slope, line.r_squared);
     let contact_time_s = inputs.contact_arc_rad / inputs.angular_speed_rad_per_s;
     let contact_area_m2 = inputs.contact_arc_rad * inputs.drum_radius_m * inputs.drum_length_m;
     if !(contact_time_s.is_finite() && contact_time_s > 0.0 && contact_area_m2 > 0.0) {
@@ -228,7 +221,7 @@ pub fn wall_heat_transfer_coefficient(t_s: &[f64], core_k: &[f64], inputs: &Wall
         contact_time_s,
         contact_area_m2,
         coefficient_w_per_m2_k: coefficient,
-        intercept: my - slope * mt,
+        intercept: line.intercept,
         wall_temperature_k: tw,
         initial_core_temperature_k: t0,
         span_s: (t[0], t[t.len() - 1]),
