@@ -20,8 +20,6 @@
 //! iteration ends (its contacts as second particle came earlier), and no later pair reads its velocity, so it is
 //! kicked right there instead of in another sweep over memory.
 
-use std::cell::Cell;
-
 use super::Vec3;
 use super::channels::{ChannelGroups, ChannelsMut, ScalarFlows};
 use super::cohesion::{Bond, BridgeConstants, Cohesion};
@@ -39,8 +37,11 @@ use super::range_plan::RangePlan;
 use super::simulation::SimConfig;
 use super::team::Team;
 
+mod motion;
 mod sweep;
 mod wall_slot;
+
+use motion::{Cells, Motion, Plain};
 
 /// What the pass knows at compile time: the contact law's history columns (Walton-Braun's, Thornton's) and whether
 /// it is the wide pass. A dry run without channels compiles to the contact loop alone; the contact history loads and
@@ -170,94 +171,6 @@ pub struct HalfKick {
     /// time of this step), saving the next step a sweep over the particle arrays. The state is then between
     /// steps; `Simulation` does this only when it runs the next step right after.
     pub fuse_next_drift: bool,
-}
-
-/// Read access to positions and velocities: plain slices while nothing writes them, cells while a serial loop
-/// kicks (and drifts) particles in place.
-trait Motion {
-    fn x(&self, i: usize) -> Vec3;
-    fn v(&self, i: usize) -> Vec3;
-    fn w(&self, i: usize) -> Vec3;
-    /// Temperature, K (a run with heat transfer only).
-    fn t(&self, i: usize) -> f64;
-}
-
-struct Plain<'a> {
-    x: &'a [Vec3],
-    v: &'a [Vec3],
-    w: &'a [Vec3],
-    t: &'a [f64],
-}
-
-impl Motion for Plain<'_> {
-    #[inline(always)]
-    fn x(&self, i: usize) -> Vec3 {
-        self.x[i]
-    }
-    #[inline(always)]
-    fn v(&self, i: usize) -> Vec3 {
-        self.v[i]
-    }
-    #[inline(always)]
-    fn w(&self, i: usize) -> Vec3 {
-        self.w[i]
-    }
-    #[inline(always)]
-    fn t(&self, i: usize) -> f64 {
-        self.t[i]
-    }
-}
-
-/// Cells over a range of particles starting at `base` (0 for all particles), indexed by global particle index.
-struct Cells<'a> {
-    x: &'a [Cell<Vec3>],
-    v: &'a [Cell<Vec3>],
-    w: &'a [Cell<Vec3>],
-    t: &'a [Cell<f64>],
-    base: usize,
-}
-
-impl<'a> Cells<'a> {
-    fn new(x: &'a mut [Vec3], v: &'a mut [Vec3], w: &'a mut [Vec3], t: &'a mut [f64], base: usize) -> Self {
-        Cells {
-            x: Cell::from_mut(x).as_slice_of_cells(),
-            v: Cell::from_mut(v).as_slice_of_cells(),
-            w: Cell::from_mut(w).as_slice_of_cells(),
-            t: Cell::from_mut(t).as_slice_of_cells(),
-            base,
-        }
-    }
-
-    #[inline(always)]
-    fn set_t(&self, i: usize, t: f64) {
-        self.t[i - self.base].set(t);
-    }
-
-    #[inline(always)]
-    fn set(&self, i: usize, x: Vec3, v: Vec3, w: Vec3) {
-        self.x[i - self.base].set(x);
-        self.v[i - self.base].set(v);
-        self.w[i - self.base].set(w);
-    }
-}
-
-impl Motion for Cells<'_> {
-    #[inline(always)]
-    fn x(&self, i: usize) -> Vec3 {
-        self.x[i - self.base].get()
-    }
-    #[inline(always)]
-    fn v(&self, i: usize) -> Vec3 {
-        self.v[i - self.base].get()
-    }
-    #[inline(always)]
-    fn w(&self, i: usize) -> Vec3 {
-        self.w[i - self.base].get()
-    }
-    #[inline(always)]
-    fn t(&self, i: usize) -> f64 {
-        self.t[i - self.base].get()
-    }
 }
 
 /// Everything one contact evaluation needs that does not change during the pass.
