@@ -1,10 +1,11 @@
 //! Walls: planes, the inside of a rotating cylinder (drum, kiln) and baffle plates fixed to a rotating frame.
 //!
 //! A wall is an infinitely large particle for the contact law (R* = R_i, m* = m_i; LAMMPS/LIGGGHTS do the same),
-//! made of a species of its own. Each wall reports, for a particle centre, the gap to its surface, the outward unit
+//! made of a species of its own; a wall of glued beads is a glued particle (R* of the pair, m* = m_i). Each wall reports, for a particle centre, the gap to its surface, the outward unit
 //! normal, and the wall's velocity at the contact point. Rotating walls carry an angle that is part of the
 //! simulation state (checkpointed); geometry here is otherwise immutable. Seed 000 builds its tumbler walls and
-//! baffles from glued particles; we use smooth surfaces, which PHYSICS §1 allows if the friction reproduces the flow.
+//! baffles from glued particles; `GluedBeads` and `PlaneBeads` build drums and planes that way (a smooth drum lets the
+//! bed slide like a bearing: research/f1-smooth-drum-slip), baffles stay smooth plates.
 
 use crate::engine::Vec3;
 use crate::engine::particles::SpeciesId;
@@ -135,6 +136,22 @@ impl Wall {
     /// A static plane (not a drum or a baffle).
     pub fn is_plane(&self) -> bool {
         matches!(self.shape, WallShape::Plane { .. })
+    }
+
+    /// The contact law's effective radius R* for a particle of radius `particle_radius_m` touching this wall: the
+    /// particle's own against a smooth surface (a partner of infinite radius), R_i R_b / (R_i + R_b) against a glued
+    /// bead of radius R_b, as against a particle of that size (seed 000 §3.4 builds the wall from particles). The
+    /// partner's mass stays infinite either way: the bead is glued.
+    #[inline]
+    pub fn contact_radius_m(&self, particle_radius_m: f64) -> f64 {
+        match self.shape {
+            WallShape::GluedBeads { bead_radius_m, .. } | WallShape::PlaneBeads { bead_radius_m, .. } => {
+                particle_radius_m * bead_radius_m / (particle_radius_m + bead_radius_m)
+            }
+            WallShape::Plane { .. } | WallShape::RotatingCylinder { .. } | WallShape::Baffle { .. } => {
+                particle_radius_m
+            }
+        }
     }
 
     /// Angular velocity of the wall's rotation (0 for static walls).
@@ -298,6 +315,33 @@ mod tests {
         assert!((p.normal - Vec3::new(0.0, 1.0, 0.0)).norm() < 1e-12);
         // Ω ẑ × (0, −1, 0.3) = (2, 0, 0): the bottom moves towards +x for counter-clockwise rotation.
         assert!((p.wall_velocity - Vec3::new(2.0, 0.0, 0.0)).norm() < 1e-12);
+    }
+
+    /// A glued bead is a particle for the contact law's R* (R_i R_b / (R_i + R_b)); a smooth wall an infinite one.
+    #[test]
+    fn a_glued_bead_contact_takes_the_pair_radius() {
+        let plane = |bead_radius_m: Option<f64>| Wall {
+            name: "floor".into(),
+            species: SpeciesId(0),
+            shape: match bead_radius_m {
+                Some(bead_radius_m) => WallShape::PlaneBeads {
+                    point_m: Vec3::zeros(),
+                    normal: Vec3::z(),
+                    e1: Vec3::x(),
+                    e2: Vec3::y(),
+                    bead_radius_m,
+                    spacing_m: [0.1, 0.1],
+                    parity: [0, 0],
+                },
+                None => WallShape::Plane {
+                    point_m: Vec3::zeros(),
+                    normal: Vec3::z(),
+                },
+            },
+        };
+        assert_eq!(plane(None).contact_radius_m(0.002), 0.002);
+        assert!((plane(Some(0.002)).contact_radius_m(0.002) - 0.001).abs() < 1e-15);
+        assert!((plane(Some(0.001)).contact_radius_m(0.002) - 0.002 / 3.0).abs() < 1e-15);
     }
 
     /// The four sub-lattices together are the whole bead lattice: the nearest of their beads is the nearest bead,

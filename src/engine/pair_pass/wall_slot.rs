@@ -1,7 +1,8 @@
 //! The wall slots of the pair pass: a particle's walls in ascending order, each slot the contact law against a
-//! partner of infinite radius and mass moving with its wall, the wall's cohesion where the run has one, and the
-//! heat a heated wall conducts into the particle (contact and gas lens). Part of `Context`, whose pair kernels are in
-//! the parent module; [`Context::complete`] calls [`Context::walls`] once a particle's pair forces are in.
+//! partner of infinite mass moving with its wall (of infinite radius, or a glued bead's: `Wall::contact_radius_m`),
+//! the wall's cohesion where the run has one, and the heat a heated wall conducts into the particle (contact and gas
+//! lens). Part of `Context`, whose pair kernels are in the parent module; [`Context::complete`] calls
+//! [`Context::walls`] once a particle's pair forces are in.
 
 use super::super::Vec3;
 use super::super::channels::ScalarFlows;
@@ -70,10 +71,11 @@ impl Context<'_> {
                 }
                 worst.note(overlap, ri, i, u32::MAX - w as u32);
                 let n = prox.normal;
+                let contact_radius_m = wall.contact_radius_m(ri);
                 let kin = ContactKinematics {
                     normal: n,
                     overlap_m: overlap,
-                    effective_radius_m: ri,
+                    effective_radius_m: contact_radius_m,
                     effective_mass_kg: self.mass_kg[i],
                     contact_velocity: vi - (wi * ri).cross(&n) - prox.wall_velocity,
                     normal_velocity_m_per_s: (vi - prox.wall_velocity).dot(&n),
@@ -90,9 +92,11 @@ impl Context<'_> {
                     && let Some(wall_temperature_k) = self.wall_temperature_k[w as usize]
                 {
                     // As in `wall_slot`.
-                    let conductance =
-                        heat.pair(self.species[i], wall.species)
-                            .conductance_w_per_k(&self.law.normal, &out, ri);
+                    let conductance = heat.pair(self.species[i], wall.species).conductance_w_per_k(
+                        &self.law.normal,
+                        &out,
+                        contact_radius_m,
+                    );
                     heat_flow_w += conductance * (wall_temperature_k - ti);
                     heat_flow_w += self.wall_lens_heat_flow_w(i, w, -overlap, ti);
                 }
@@ -140,7 +144,7 @@ impl Context<'_> {
     /// One wall slot of particle i (local slot `k`, slot `slot` of the whole list): the contact law's force and
     /// torque on i while it overlaps the wall (otherwise the contact history is released), and the cohesion model's
     /// while it acts, the wall a partner of infinite radius and mass (R* = R_i, μ = m_i, a square well twice as
-    /// deep: seed 001 §6.2.4.2). Third: the flows of a contact that ended here (where the run records channels).
+    /// deep: seed 001 §6.2.4.2; the contact law takes a glued bead's R* of the pair, the cohesion models keep R_i). Third: the flows of a contact that ended here (where the run records channels).
     #[allow(clippy::too_many_arguments)]
     #[inline(always)]
     pub(super) fn wall_slot<P: PassKind>(
@@ -174,10 +178,11 @@ impl Context<'_> {
         } else {
             worst.note(overlap, ri, i, u32::MAX - w as u32);
             let n = prox.normal;
+            let contact_radius_m = wall.contact_radius_m(ri);
             let kin = ContactKinematics {
                 normal: n,
                 overlap_m: overlap,
-                effective_radius_m: ri,
+                effective_radius_m: contact_radius_m,
                 effective_mass_kg: self.mass_kg[i],
                 contact_velocity: vi - (wi * ri).cross(&n) - prox.wall_velocity,
                 normal_velocity_m_per_s: (vi - prox.wall_velocity).dot(&n),
@@ -194,9 +199,11 @@ impl Context<'_> {
             {
                 // The wall an infinite particle at its own temperature (seed 000 §5.1.2.1); adiabatic walls pass
                 // nothing.
-                let conductance =
-                    heat.pair(self.species[i], wall.species)
-                        .conductance_w_per_k(&self.law.normal, &out, ri);
+                let conductance = heat.pair(self.species[i], wall.species).conductance_w_per_k(
+                    &self.law.normal,
+                    &out,
+                    contact_radius_m,
+                );
                 flows.heat_flow_w = conductance * (wall_temperature_k - ti);
                 flows.heat_flow_w += self.wall_lens_heat_flow_w(i, w, -overlap, ti);
             }

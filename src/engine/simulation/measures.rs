@@ -49,7 +49,11 @@ impl Simulation {
                 let wall = &c.walls[w];
                 let overlap = p.radius_m[i] - wall.proximity(&p.position_m[i], self.wall_angle_rad[w]).gap_m;
                 if overlap > 0.0 {
-                    e += potential(c.pair_table.get(p.species[i], wall.species), p.radius_m[i], overlap);
+                    e += potential(
+                        c.pair_table.get(p.species[i], wall.species),
+                        wall.contact_radius_m(p.radius_m[i]),
+                        overlap,
+                    );
                 }
             }
         }
