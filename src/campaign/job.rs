@@ -55,17 +55,54 @@ impl JobSpec {
         serde_json::to_string(&map).expect("params serialise")
     }
 
-    /// A short description for logs: `a=1, b=x`.
+    /// A short description for logs and `granflow status`: `a=1, b=x`, each parameter by its shortest unique name.
     pub fn label(&self) -> String {
+        let paths: Vec<&str> = self.params.iter().map(|(k, _)| k.as_str()).collect();
         self.params
             .iter()
-            .map(|(k, v)| format!("{}={}", short_name(k), v))
+            .map(|(k, v)| format!("{}={}", short_name(k, &paths), v))
             .collect::<Vec<_>>()
             .join(", ")
     }
 }
 
-/// The last key of a parameter path (`walls[0].drum.rotation_rpm` → `rotation_rpm`), the name shown in tables.
-pub fn short_name(path: &str) -> &str {
-    path.rsplit('.').next().unwrap_or(path)
+/// The last key of a parameter path (`walls[0].drum.rotation_rpm` → `rotation_rpm`), or as many of its last keys as
+/// tell it apart from the other `paths` (`species[0].rolling_friction_coefficient` beside `species[1]`'s).
+pub fn short_name<'a>(path: &'a str, paths: &[&str]) -> &'a str {
+    let ends: Vec<usize> = path.match_indices('.').map(|(at, _)| at + 1).rev().chain([0]).collect();
+    for &start in &ends {
+        let suffix = &path[start..];
+        let shared = paths
+            .iter()
+            .filter(|other| **other != path)
+            .any(|other| *other == suffix || other.ends_with(&format!(".{suffix}")));
+        if !shared {
+            return suffix;
+        }
+    }
+    path
+}
+
+#[cfg(test)]
+mod tests {
+    use super::short_name;
+
+    #[test]
+    fn a_parameter_is_named_by_as_many_last_keys_as_tell_it_apart() {
+        let paths = [
+            "species[0].rolling_friction_coefficient",
+            "species[1].rolling_friction_coefficient",
+            "walls[0].drum.rotation_rpm",
+            "gas.velocity_m_per_s",
+        ];
+        assert_eq!(short_name(paths[0], &paths), "species[0].rolling_friction_coefficient");
+        assert_eq!(short_name(paths[1], &paths), "species[1].rolling_friction_coefficient");
+        assert_eq!(short_name(paths[2], &paths), "rotation_rpm");
+        assert_eq!(short_name(paths[3], &paths), "velocity_m_per_s");
+        // A path that is the other's tail keeps one key more than the tail.
+        let nested = ["a.b.c", "b.c"];
+        assert_eq!(short_name(nested[0], &nested), "a.b.c");
+        assert_eq!(short_name(nested[1], &nested), "b.c");
+        assert_eq!(short_name("named.simulation", &["named.simulation"]), "simulation");
+    }
 }
