@@ -132,6 +132,12 @@ impl Rate {
     }
 }
 
+/// Particle i's thermal mass m_i c_p,i (J/K), which the latent heat of what evaporates cools.
+#[inline]
+fn thermal_mass_j_per_k(p: &Particles, heat_capacity_j_per_kg_k: &[f64], i: usize) -> f64 {
+    p.mass_kg[i] * heat_capacity_j_per_kg_k[p.species[i].index()]
+}
+
 /// The liquid each particle holds, m³: its film plus half of each of its pair bridges and all of each wall bridge.
 fn liquid_pools_m3(p: &Particles, list: &NeighborList, history: &AlignedHistory) -> Vec<f64> {
     let mut pool = p.liquid_m3.clone();
@@ -205,7 +211,7 @@ pub fn dry(
         let t = p.temperature_k[i];
         let a =
             hertz_knudsen_conductance_kg_per_s_pa(config.evaporation_coefficient, 2.0 * p.radius_m[i], t, molar_mass);
-        let thermal_mass = p.mass_kg[i] * heat_capacity_j_per_kg_k[p.species[i].index()];
+        let thermal_mass = thermal_mass_j_per_k(p, heat_capacity_j_per_kg_k, i);
         let d = 1.0 + a * saturation_pressure_slope_pa_per_k(t) * latent * dt_s / thermal_mass;
         let pressure_per_density = GAS_CONSTANT_J_PER_MOL_K * temperature[c] / molar_mass;
         rates.push(Some(Rate {
@@ -286,7 +292,7 @@ pub fn dry(
             p.liquid_m3[i] -= m_kg / config.liquid_density_kg_per_m3;
         }
         step.evaporated_kg += m_kg;
-        let thermal_mass = p.mass_kg[i] * heat_capacity_j_per_kg_k[p.species[i].index()];
+        let thermal_mass = thermal_mass_j_per_k(p, heat_capacity_j_per_kg_k, i);
         p.temperature_k[i] -= m_kg * latent / thermal_mass;
     }
     for (liquid, &f) in p.liquid_m3.iter_mut().zip(&fraction) {
@@ -350,7 +356,7 @@ pub fn dry(
             let m_kg = film * config.liquid_density_kg_per_m3;
             p.liquid_m3[i] = 0.0;
             w[r.cell] += m_kg / (porosity[r.cell] * rho * volume);
-            let thermal_mass = p.mass_kg[i] * heat_capacity_j_per_kg_k[p.species[i].index()];
+            let thermal_mass = thermal_mass_j_per_k(p, heat_capacity_j_per_kg_k, i);
             p.temperature_k[i] -= m_kg * latent / thermal_mass;
             step.evaporated_kg += m_kg;
         }

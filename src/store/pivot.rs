@@ -112,26 +112,13 @@ impl Store {
             None => format!("laying out `{metric}` over `{x_param}` in campaign {campaign_id}"),
         };
 
-        let parameters: Vec<String> = self
-            .strings(
-                "SELECT DISTINCT p.name FROM params p JOIN jobs j ON j.job_id = p.job_id
-                 WHERE j.campaign_id = ?1 ORDER BY p.name",
-                params![campaign_id],
-            )
-            .context(&self.path, &action)?;
-        for name in std::iter::once(x_param)
-            .chain(y_param)
-            .chain(filters.iter().map(|(name, _)| name.as_str()))
-        {
-            if !parameters.iter().any(|known| known == name) {
-                return Err(StoreError::UnknownParameter {
-                    path: self.path.clone(),
-                    campaign_id,
-                    name: name.to_string(),
-                    available: parameters,
-                });
-            }
-        }
+        self.require_parameters(
+            campaign_id,
+            std::iter::once(x_param)
+                .chain(y_param)
+                .chain(filters.iter().map(|(name, _)| name.as_str())),
+            &action,
+        )?;
         let metrics: Vec<String> = self
             .strings(
                 "SELECT DISTINCT m.name FROM metrics m JOIN jobs j ON j.job_id = m.job_id
@@ -173,13 +160,9 @@ impl Store {
             .context(&self.path, &action)?;
         let mut kept: Option<std::collections::HashSet<String>> = None;
         for (name, wanted) in filters {
-            let matching: std::collections::HashSet<String> = self
-                .job_values(campaign_id, name)
-                .context(&self.path, &action)?
-                .into_iter()
-                .filter(|(_, value)| value.axis_cmp(wanted) == Ordering::Equal)
-                .map(|(job, _)| job)
-                .collect();
+            let matching = self
+                .jobs_with_value(campaign_id, name, wanted)
+                .context(&self.path, &action)?;
             kept = Some(match kept {
                 None => matching,
                 Some(k) => k.intersection(&matching).cloned().collect(),
@@ -221,21 +204,7 @@ impl Store {
     ) -> Result<Vec<String>, StoreError> {
         self.require_campaign(campaign_id)?;
         let action = format!("listing the done jobs of campaign {campaign_id}");
-        let parameters: Vec<String> = self
-            .strings(
-                "SELECT DISTINCT p.name FROM params p JOIN jobs j ON j.job_id = p.job_id
-                 WHERE j.campaign_id = ?1 ORDER BY p.name",
-                params![campaign_id],
-            )
-            .context(&self.path, &action)?;
-        if let Some((name, _)) = filters.iter().find(|(name, _)| !parameters.contains(name)) {
-            return Err(StoreError::UnknownParameter {
-                path: self.path.clone(),
-                campaign_id,
-                name: name.clone(),
-                available: parameters,
-            });
-        }
+        self.require_parameters(campaign_id, filters.iter().map(|(name, _)| name.as_str()), &action)?;
         let mut jobs: Vec<String> = self
             .strings(
                 "SELECT job_id FROM jobs WHERE campaign_id = ?1 AND status = ?2 ORDER BY ordinal",
@@ -243,16 +212,56 @@ impl Store {
             )
             .context(&self.path, &action)?;
         for (name, wanted) in filters {
-            let matching: std::collections::HashSet<String> = self
-                .job_values(campaign_id, name)
-                .context(&self.path, &action)?
-                .into_iter()
-                .filter(|(_, value)| value.axis_cmp(wanted) == Ordering::Equal)
-                .map(|(job, _)| job)
-                .collect();
+            let matching = self
+                .jobs_with_value(campaign_id, name, wanted)
+                .context(&self.path, &action)?;
             jobs.retain(|job| matching.contains(job));
         }
         Ok(jobs)
+    }
+
+    /// Fails with [`StoreError::UnknownParameter`] (listing the campaign's parameters) at the first of `names` the
+    /// campaign does not sweep; `action` says what was being done, for other errors.
+    fn require_parameters<'n>(
+        &self,
+        campaign_id: i64,
+        names: impl IntoIterator<Item = &'n str>,
+        action: &str,
+    ) -> Result<(), StoreError> {
+        let parameters: Vec<String> = self
+            .strings(
+                "SELECT DISTINCT p.name FROM params p JOIN jobs j ON j.job_id = p.job_id
+                 WHERE j.campaign_id = ?1 ORDER BY p.name",
+                params![campaign_id],
+            )
+            .context(&self.path, action)?;
+        for name in names {
+            if !parameters.iter().any(|known| known == name) {
+                return Err(StoreError::UnknownParameter {
+                    path: self.path.clone(),
+                    campaign_id,
+                    name: name.to_string(),
+                    available: parameters,
+                });
+            }
+        }
+        Ok(())
+    }
+
+    /// The jobs of the campaign whose parameter `name` equals `wanted` (a filter of `pivot_where` and
+    /// `done_jobs_where`).
+    fn jobs_with_value(
+        &self,
+        campaign_id: i64,
+        name: &str,
+        wanted: &ParamValue,
+    ) -> rusqlite::Result<std::collections::HashSet<String>> {
+        Ok(self
+            .job_values(campaign_id, name)?
+            .into_iter()
+            .filter(|(_, value)| value.axis_cmp(wanted) == Ordering::Equal)
+            .map(|(job, _)| job)
+            .collect())
     }
 
     /// (job id, value) of parameter `name` for every job of the campaign that has it.
