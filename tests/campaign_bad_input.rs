@@ -624,6 +624,15 @@ const CASES: &[(&str, &str, &str, &[&str])] = &[
         ],
     ),
     (
+        "coating fit from before the start",
+        "analysis: { mixing_species: red }",
+        "analysis: { mixing_species: red, coating_fit_from_s: -1.0 }",
+        &[
+            "analysis.coating_fit_from_s",
+            "expected 0 <= value < the end time (0.002 s), got -1",
+        ],
+    ),
+    (
         "a misspelt field that the base leaves at its default (not written out)",
         "  grid:\n",
         "  grid:\n    - { param: output.net_force, values: [true] }\n",
