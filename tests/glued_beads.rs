@@ -2,8 +2,9 @@
 //! a cylindrical geometry"): a drum slice of 3 mm beads turning at 6 rpm, once with a smooth wall and once with 40
 //! beads glued around it. On the smooth wall the outer layer turns like the balls of a bearing — spinning at about
 //! R/(2a) times the drum's rate while its centres lag at about half the wall's speed — and the bed does not lift; on
-//! the beads the outer layer turns with the drum as a solid body. A run with beads resumes bit for bit on another
-//! thread count, and impossible bead lattices are bad input at their key.
+//! the beads the outer layer turns with the drum as a solid body. A sphere resting on a bead sinks to Hertz's overlap
+//! for the pair (the bead a glued particle), a run with beads resumes bit for bit on another thread count, and
+//! impossible bead lattices are bad input at their key.
 
 mod common;
 
@@ -74,6 +75,46 @@ fn glued_beads_turn_the_bed_with_the_drum_where_a_smooth_wall_lets_it_roll() {
     assert!(
         (0.65..=0.95).contains(&rough_speed) && (0.5..=1.5).contains(&rough_spin),
         "beads: v/(ΩR) = {rough_speed}, spin/Ω = {rough_spin} over {n} particles"
+    );
+}
+
+/// A sphere of radius r resting on top of a glued bead of radius r_b sinks to Hertz's static overlap for the pair,
+/// m g = 4/3 E* √R* δ^{3/2} with R* = r r_b / (r + r_b): the bead is a glued particle, not a flat wall (whose
+/// R* = r would give an overlap 2^{-1/3} as deep for equal radii).
+#[test]
+fn a_sphere_resting_on_a_glued_bead_sinks_to_the_pair_hertz_overlap() {
+    let (r, r_b, density, e, nu, g) = (0.001, 0.001, 2500.0, 1.0e8, 0.3, 9.81);
+    let yaml = format!(
+        r#"name: bead-rest
+domain: {{ lo_m: [-0.01, -0.01, 0.0], hi_m: [0.01, 0.01, 0.01], periodic: [false, false, false] }}
+gravity: {{ vector_m_per_s2: [0.0, 0.0, -{g}] }}
+species:
+  - {{ name: glass, radius_m: {r}, density_kg_per_m3: {density}, youngs_modulus_pa: {e}, poisson_ratio: {nu}, friction_coefficient: 0.5 }}
+contact: {{ normal: {{ hertz: {{ restitution: 0.3 }} }}, tangential: mindlin }}
+walls:
+  - plane: {{ name: floor, species: glass, point_m: [0.0, 0.0, 0.0], normal: [0.0, 0.0, 1.0], glued_beads: {{ radius_m: {r_b}, spacing_m: [0.004, 0.004] }} }}
+fill:
+  - explicit: {{ species: glass, positions_m: [[0.0, 0.0, {z0}]] }}
+time: {{ dt_fraction_of_contact_time: 0.05, end_time_s: 0.02 }}
+seed: 1
+"#,
+        z0 = r + r_b
+    );
+    let b = built(&yaml);
+    let mut sim = simulation(&b, 1);
+    sim.run_steps((0.02 / b.dt_s).round() as u64).expect("runs");
+    let s = sim.snapshot();
+    let x = s.particles.position_m[0];
+    assert!(x.x == 0.0 && x.y == 0.0, "the sphere left the bead's top: {x:?}");
+    let overlap_m = r + r_b - x.z;
+    let weight_n = density * 4.0 / 3.0 * std::f64::consts::PI * r.powi(3) * g;
+    let e_star = e / (2.0 * (1.0 - nu * nu));
+    let hertz = |r_star: f64| (weight_n / (4.0 / 3.0 * e_star * r_star.sqrt())).powf(2.0 / 3.0);
+    let (pair, flat) = (hertz(r * r_b / (r + r_b)), hertz(r));
+    println!("overlap {overlap_m:.6e} m; Hertz for the pair {pair:.6e} m, for a flat wall {flat:.6e} m");
+    assert!(
+        (overlap_m - pair).abs() < 1e-3 * pair,
+        "overlap {overlap_m:e} m against the pair's {pair:e} m (a flat wall's: {flat:e} m)"
     );
 }
 
