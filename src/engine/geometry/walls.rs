@@ -41,19 +41,18 @@ impl RotatingFrame {
         (self.axis * self.angular_velocity_rad_per_s).cross(&(p - self.axis_point_m))
     }
 
-    /// In-plane coordinates (u, v) of world point `p` in the frame turned by `angle_rad`.
+    /// In-plane coordinates (u, v) of world point `p` in the frame turned by an angle whose (sine, cosine) is
+    /// `turn` (`angle.sin_cos()`, computed once per proximity).
     #[inline]
-    fn body_coordinates(&self, p: &Vec3, angle_rad: f64) -> (f64, f64) {
+    fn body_coordinates(&self, p: &Vec3, (s, c): (f64, f64)) -> (f64, f64) {
         let r = p - self.axis_point_m;
         let (u, v) = (r.dot(&self.e1), r.dot(&self.e2));
-        let (s, c) = angle_rad.sin_cos();
         (u * c + v * s, -u * s + v * c)
     }
 
-    /// World vector of in-plane body vector (du, dv) in the frame turned by `angle_rad`.
+    /// World vector of in-plane body vector (du, dv) in the frame turned by the angle whose (sine, cosine) is `turn`.
     #[inline]
-    fn world_vector(&self, du: f64, dv: f64, angle_rad: f64) -> Vec3 {
-        let (s, c) = angle_rad.sin_cos();
+    fn world_vector(&self, du: f64, dv: f64, (s, c): (f64, f64)) -> Vec3 {
         self.e1 * (du * c - dv * s) + self.e2 * (du * s + dv * c)
     }
 }
@@ -216,7 +215,8 @@ impl Wall {
                 end_m,
                 half_thickness_m,
             } => {
-                let (u, v) = frame.body_coordinates(x, angle_rad);
+                let turn = angle_rad.sin_cos();
+                let (u, v) = frame.body_coordinates(x, turn);
                 let (su, sv) = (end_m[0] - start_m[0], end_m[1] - start_m[1]);
                 let len2 = su * su + sv * sv;
                 let t = if len2 > 0.0 {
@@ -227,9 +227,9 @@ impl Wall {
                 let (du, dv) = (u - start_m[0] - t * su, v - start_m[1] - t * sv);
                 let dist = (du * du + dv * dv).sqrt();
                 let normal = if dist > 0.0 {
-                    frame.world_vector(du / dist, dv / dist, angle_rad)
+                    frame.world_vector(du / dist, dv / dist, turn)
                 } else {
-                    frame.world_vector(-sv, su, angle_rad).normalize()
+                    frame.world_vector(-sv, su, turn).normalize()
                 };
                 let contact_point = x - normal * (dist - half_thickness_m);
                 WallProximity {
@@ -269,22 +269,22 @@ impl Wall {
                 axial_spacing_m,
                 parity,
             } => {
-                let (u, v) = frame.body_coordinates(x, angle_rad);
+                let turn = angle_rad.sin_cos();
+                let (u, v) = frame.body_coordinates(x, turn);
                 let step_rad = 2.0 * std::f64::consts::PI / f64::from(*count_around);
                 let theta = nearest_with_parity(v.atan2(u) / step_rad, parity[0]) * step_rad;
                 let axial_m = (x - frame.axis_point_m).dot(&frame.axis);
                 let ring_m = nearest_with_parity(axial_m / axial_spacing_m, parity[1]) * axial_spacing_m;
                 let (s, co) = theta.sin_cos();
-                let centre = frame.axis_point_m
-                    + frame.axis * ring_m
-                    + frame.world_vector(radius_m * co, radius_m * s, angle_rad);
+                let centre =
+                    frame.axis_point_m + frame.axis * ring_m + frame.world_vector(radius_m * co, radius_m * s, turn);
                 let d = x - centre;
                 let dist = d.norm();
                 // A centre on the bead's own centre: push it inwards, towards the axis.
                 let normal = if dist > 0.0 {
                     d / dist
                 } else {
-                    -frame.world_vector(co, s, angle_rad)
+                    -frame.world_vector(co, s, turn)
                 };
                 let contact_point = centre + normal * *bead_radius_m;
                 WallProximity {
