@@ -18,6 +18,8 @@ pub struct HeatedDrum {
     pub temperature_k: f64,
     /// The wall heats from this time, s.
     pub heated_from_s: f64,
+    /// The radius of the beads glued to it (`walls[].drum.glued_beads`), m; 0 for a smooth wall.
+    pub bead_radius_m: f64,
     /// |ω|, rad/s.
     pub angular_speed_rad_per_s: f64,
     /// L: the domain's extent along the axis (the drum slice's length), m; NaN when the axis is not along one of
@@ -45,6 +47,19 @@ pub fn heated_drum(config: &SimConfig) -> Option<HeatedDrum> {
             },
             temperature_k,
             heated_from_s: heat.wall_heated_from_s[w],
+            bead_radius_m: config
+                .walls
+                .iter()
+                .filter_map(|other| match other.shape {
+                    WallShape::GluedBeads {
+                        frame: f,
+                        radius_m: r,
+                        bead_radius_m,
+                        ..
+                    } if f == *frame && r == *radius_m => Some(bead_radius_m),
+                    _ => None,
+                })
+                .fold(0.0, f64::max),
             angular_speed_rad_per_s: frame.angular_velocity_rad_per_s.abs(),
             length_m: along.map_or(f64::NAN, |k| config.domain.hi_m[k] - config.domain.lo_m[k]),
         })
@@ -77,7 +92,7 @@ pub fn drum_heat_columns(sim: &Simulation, drum: &HeatedDrum, core_radius_fracti
         &p.temperature_k,
         0.5 * core_radius_fraction,
     );
-    let arc = wall_contact_arc_rad(&drum.axis, &p.position_m, &p.radius_m);
+    let arc = wall_contact_arc_rad(&drum.axis, &p.position_m, &p.radius_m, drum.bead_radius_m);
     let gas = sim
         .gas
         .as_ref()

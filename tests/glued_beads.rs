@@ -118,6 +118,51 @@ seed: 1
     );
 }
 
+/// A heated floor heats through its glued beads (`heat.walls.floor` holds for the floor's beads): a sphere resting on
+/// a bead at 400 K warms at the rate of the pair's Hertz contact, H = 2 k √(R* δ) (seed 000 eq. 5.4) with R* and δ
+/// the pair's: T(t) = T_w − (T_w − T_0) exp(−H t / (m c)).
+#[test]
+fn a_heated_floor_conducts_through_its_glued_beads_as_a_pair_contact() {
+    let (r, r_b, density, e, nu, g): (f64, f64, f64, f64, f64, f64) = (0.001, 0.001, 2500.0, 1.0e8, 0.3, 9.81);
+    let (k, c, t_wall, t0, end_s): (f64, f64, f64, f64, f64) = (1.0, 800.0, 400.0, 300.0, 0.02);
+    let weight_n = density * 4.0 / 3.0 * std::f64::consts::PI * r.powi(3) * g;
+    let e_star = e / (2.0 * (1.0 - nu * nu));
+    let r_star = r * r_b / (r + r_b);
+    let overlap_m = (weight_n / (4.0 / 3.0 * e_star * r_star.sqrt())).powf(2.0 / 3.0);
+    let yaml = format!(
+        r#"name: bead-heat
+domain: {{ lo_m: [-0.01, -0.01, 0.0], hi_m: [0.01, 0.01, 0.01], periodic: [false, false, false] }}
+gravity: {{ vector_m_per_s2: [0.0, 0.0, -{g}] }}
+species:
+  - {{ name: glass, radius_m: {r}, density_kg_per_m3: {density}, youngs_modulus_pa: {e}, poisson_ratio: {nu}, friction_coefficient: 0.5, thermal_conductivity_w_per_m_k: {k}, heat_capacity_j_per_kg_k: {c} }}
+contact: {{ normal: {{ hertz: {{ restitution: 0.3 }} }}, tangential: mindlin }}
+walls:
+  - plane: {{ name: floor, species: glass, point_m: [0.0, 0.0, 0.0], normal: [0.0, 0.0, 1.0], glued_beads: {{ radius_m: {r_b}, spacing_m: [0.004, 0.004] }} }}
+fill:
+  - explicit: {{ species: glass, positions_m: [[0.0, 0.0, {z0}]] }}
+time: {{ dt_fraction_of_contact_time: 0.05, end_time_s: {end_s} }}
+heat: {{ initial_temperature_k: {t0}, walls: {{ floor: {{ temperature_k: {t_wall} }} }} }}
+seed: 1
+"#,
+        z0 = r + r_b - overlap_m
+    );
+    let b = built(&yaml);
+    let mut sim = simulation(&b, 1);
+    let steps = (end_s / b.dt_s).round() as u64;
+    sim.run_steps(steps).expect("runs");
+    let t_end = sim.snapshot().particles.temperature_k[0];
+    let mass_kg = weight_n / g;
+    let conductance_w_per_k = 2.0 * k * (r_star * overlap_m).sqrt();
+    let expected = t_wall - (t_wall - t0) * (-conductance_w_per_k * steps as f64 * b.dt_s / (mass_kg * c)).exp();
+    println!("after {end_s} s: {t_end:.9} K, the pair contact's {expected:.9} K");
+    assert!(
+        ((t_end - t0) - (expected - t0)).abs() < 2e-3 * (expected - t0),
+        "warmed by {} K, the pair contact by {} K",
+        t_end - t0,
+        expected - t0
+    );
+}
+
 #[test]
 fn a_drum_with_glued_beads_resumes_bit_for_bit() {
     let tmp = tempfile::tempdir().unwrap();

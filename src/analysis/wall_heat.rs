@@ -77,11 +77,12 @@ pub fn bed_core(
 /// Two wall contacts further apart round the drum than this many particle diameters belong to different runs.
 const ARC_GAP_DIAMETERS: f64 = 4.0;
 
-/// The angle of wall the bed touches, rad: the particles whose surface reaches the drum (centre beyond R − r) are
-/// sorted by their angle round the axis and cut into runs where neighbours are more than four diameters apart;
-/// the span of the run with the most particles (a stray particle elsewhere on the wall does not widen it). 0
-/// without contacts.
-pub fn wall_contact_arc_rad(drum: &DrumAxis, positions_m: &[Vec3], radii_m: &[f64]) -> f64 {
+/// The angle of wall the bed touches, rad: the particles whose surface reaches the drum (centre beyond R − r, or
+/// beyond R − r − r_b on a wall of glued beads of radius `bead_radius_m` = r_b, whose centres lie on the cylinder:
+/// within reach of a bead) are sorted by their angle round the axis and cut into runs where neighbours are more
+/// than four diameters apart; the span of the run with the most particles (a stray particle elsewhere on the wall
+/// does not widen it). 0 without contacts.
+pub fn wall_contact_arc_rad(drum: &DrumAxis, positions_m: &[Vec3], radii_m: &[f64], bead_radius_m: f64) -> f64 {
     // Any unit vector across the axis as the angle's origin.
     let e1 = drum
         .axis
@@ -94,7 +95,7 @@ pub fn wall_contact_arc_rad(drum: &DrumAxis, positions_m: &[Vec3], radii_m: &[f6
         .zip(radii_m)
         .filter_map(|(x, r)| {
             let d = drum.across(x);
-            (d.norm() > drum.radius_m - r).then(|| d.dot(&e2).atan2(d.dot(&e1)))
+            (d.norm() > drum.radius_m - r - bead_radius_m).then(|| d.dot(&e2).atan2(d.dot(&e1)))
         })
         .collect();
     if angles.is_empty() {
@@ -304,12 +305,23 @@ mod tests {
         // Particles away from the wall do not count.
         x.push(Vec3::new(0.0, -0.05, 0.0));
         let radii = vec![r; x.len()];
-        let arc = wall_contact_arc_rad(&DRUM, &x, &radii);
+        let arc = wall_contact_arc_rad(&DRUM, &x, &radii, 0.0);
         assert!((arc - 120f64.to_radians()).abs() < 1e-12, "{}", arc.to_degrees());
         // A run across ±180° is not split.
         let across: Vec<Vec3> = (0..=20).map(|k| at(150.0 + 3.0 * k as f64)).collect();
-        let arc = wall_contact_arc_rad(&DRUM, &across, &vec![r; across.len()]);
+        let arc = wall_contact_arc_rad(&DRUM, &across, &vec![r; across.len()], 0.0);
         assert!((arc - 60f64.to_radians()).abs() < 1e-12, "{}", arc.to_degrees());
-        assert_eq!(wall_contact_arc_rad(&DRUM, &[Vec3::zeros()], &[r]), 0.0);
+        assert_eq!(wall_contact_arc_rad(&DRUM, &[Vec3::zeros()], &[r], 0.0), 0.0);
+        // On glued beads of radius r the bed's outer layer sits up to a bead radius further in (here at R − 1.4 r,
+        // in the hollows between beads): it touches the beads, not the cylinder.
+        let hollow = |deg: f64| {
+            let a = deg.to_radians();
+            Vec3::new((0.1 - 1.4 * r) * a.cos(), (0.1 - 1.4 * r) * a.sin(), 0.0)
+        };
+        let layer: Vec<Vec3> = (0..=30).map(|k| hollow(-120.0 + 2.0 * k as f64)).collect();
+        let radii = vec![r; layer.len()];
+        assert_eq!(wall_contact_arc_rad(&DRUM, &layer, &radii, 0.0), 0.0);
+        let arc = wall_contact_arc_rad(&DRUM, &layer, &radii, r);
+        assert!((arc - 60f64.to_radians()).abs() < 1e-12, "{}", arc.to_degrees());
     }
 }

@@ -10,6 +10,8 @@ use std::sync::Arc;
 mod fill;
 mod walls;
 
+pub(super) use walls::walls_named;
+
 use super::ConfigError;
 use super::spec::{FillSpec, GravitySpec, ScenarioSpec, SpeciesSpec, WallSpec};
 use crate::engine::Vec3;
@@ -312,14 +314,16 @@ pub fn build(spec: ScenarioSpec, path: &Path) -> Result<BuiltScenario, ConfigErr
             if cohesion.wall_range_m <= 0.0 {
                 return Err(c.fail(key, "the cohesion model does not act on walls (its `walls` is false)"));
             }
-            let Some(w) = walls.iter().position(|w| &w.name == name) else {
+            let Some(named) = walls_named(&walls, name) else {
                 let names: Vec<&str> = walls.iter().map(|w| w.name.as_str()).collect();
                 return Err(c.fail(
                     key,
                     format!("no wall named '{name}'; the walls are: {}", names.join(", ")),
                 ));
             };
-            cohesion.wall_on[w] = false;
+            for w in named {
+                cohesion.wall_on[w] = false;
+            }
         }
     }
     if !matches!(spec.cohesion, Some(CohesionModel::LiquidBridge(_)))

@@ -3,6 +3,7 @@
 use std::path::Path;
 
 use super::ConfigError;
+use super::build::walls_named;
 use super::gas::GasSetup;
 use super::spec::ScenarioSpec;
 use crate::engine::gas::heat::GasThermal;
@@ -135,7 +136,7 @@ pub(super) fn build_heat(
     let mut wall_heated_from_s = vec![0.0; walls.len()];
     for (name, condition) in &heat.walls {
         let key = |field: &str| format!("heat.walls.{name}{field}");
-        let Some(w) = walls.iter().position(|w| &w.name == name) else {
+        let Some(named) = walls_named(walls, name) else {
             let names: Vec<&str> = walls.iter().map(|w| w.name.as_str()).collect();
             return Err(fail(
                 key(""),
@@ -151,8 +152,10 @@ pub(super) fn build_heat(
                         format!("expected a time >= 0 s, got {}", condition.from_s),
                     ));
                 }
-                wall_temperature_k[w] = Some(t);
-                wall_heated_from_s[w] = condition.from_s;
+                for w in named {
+                    wall_temperature_k[w] = Some(t);
+                    wall_heated_from_s[w] = condition.from_s;
+                }
             }
             (None, true) => {}
             (Some(_), true) => {

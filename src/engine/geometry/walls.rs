@@ -143,13 +143,20 @@ impl Wall {
     /// partner's mass stays infinite either way: the bead is glued.
     #[inline]
     pub fn contact_radius_m(&self, particle_radius_m: f64) -> f64 {
+        match self.bead_radius_m() {
+            Some(bead_radius_m) => particle_radius_m * bead_radius_m / (particle_radius_m + bead_radius_m),
+            None => particle_radius_m,
+        }
+    }
+
+    /// The radius of the wall's glued beads, or `None` for a smooth wall.
+    #[inline]
+    pub fn bead_radius_m(&self) -> Option<f64> {
         match self.shape {
             WallShape::GluedBeads { bead_radius_m, .. } | WallShape::PlaneBeads { bead_radius_m, .. } => {
-                particle_radius_m * bead_radius_m / (particle_radius_m + bead_radius_m)
+                Some(bead_radius_m)
             }
-            WallShape::Plane { .. } | WallShape::RotatingCylinder { .. } | WallShape::Baffle { .. } => {
-                particle_radius_m
-            }
+            WallShape::Plane { .. } | WallShape::RotatingCylinder { .. } | WallShape::Baffle { .. } => None,
         }
     }
 

@@ -3,7 +3,7 @@
 //! (the wall an infinite particle at its own temperature, §5.1.2.1).
 //!
 //! - **Contact radius.** R_c is the Hertz radius √(R* δ) the contact law reports, R* = R_i R_j/(R_i + R_j) (R_i on a
-//!   wall). Seed 000 writes √(R α) in eq. 5.15 (√2 larger for equal spheres); Hertz's is the radius of the
+//!   smooth wall, the pair's on a glued bead). Seed 000 writes √(R α) in eq. 5.15 (√2 larger for equal spheres); Hertz's is the radius of the
 //!   circle the two spheres actually share, so we use it, as `PHYSICS.md` §4 asks us to say.
 //! - **Two solids.** k_s is the harmonic mean 2 k_i k_j/(k_i + k_j) of the two conductivities (the series
 //!   resistance of the two half-contacts; equal to k for like materials). A wall whose material states no

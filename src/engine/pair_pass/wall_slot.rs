@@ -17,13 +17,19 @@ type WallSlotResult = (Option<(Vec3, Vec3)>, Option<(Vec3, Vec3)>, ScalarFlows);
 
 impl Context<'_> {
     /// Conduction through the gas lens between particle i (temperature `ti`) and wall `w` at surface gap `gap_m`
-    /// (negative in overlap), if the run has the lens and the wall is heated: H (T_w − T_i) into i, W.
+    /// (negative in overlap), if the run has the lens and the wall is heated: H (T_w − T_i) into i, W. A glued bead
+    /// is a sphere of its own radius for the lens, as for the contact.
     #[inline(always)]
     pub(super) fn wall_lens_heat_flow_w(&self, i: usize, w: u16, gap_m: f64, ti: f64) -> f64 {
         if let Some(lens) = self.heat.and_then(|h| h.lens.as_ref())
             && let Some(wall_temperature_k) = self.wall_temperature_k[w as usize]
         {
-            lens.wall_conductance_w_per_k(self.radius_m[i], gap_m) * (wall_temperature_k - ti)
+            let ri = self.radius_m[i];
+            let conductance = match self.config.walls[w as usize].bead_radius_m() {
+                Some(rb) => lens.pair_conductance_w_per_k(ri, rb, ri + rb + gap_m),
+                None => lens.wall_conductance_w_per_k(ri, gap_m),
+            };
+            conductance * (wall_temperature_k - ti)
         } else {
             0.0
         }

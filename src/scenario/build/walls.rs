@@ -246,6 +246,18 @@ fn baffle_segments(
     Ok(out)
 }
 
+/// The walls a wall's name in the scenario stands for: the wall of that name and, for a drum or a plane with glued
+/// beads, its four bead sub-lattices (`<name>_beads_<k><j>`), which are part of it: a heated drum heats through its
+/// beads too, and `cohesion_off` for a wall holds for its beads. `None` when no wall has the name.
+pub(in crate::scenario) fn walls_named(walls: &[Wall], name: &str) -> Option<Vec<usize>> {
+    let own = walls.iter().position(|w| w.name == name)?;
+    let prefix = format!("{name}_beads_");
+    let beads = walls.iter().enumerate().filter(|(_, w)| {
+        w.name.starts_with(&prefix) && matches!(w.shape, WallShape::GluedBeads { .. } | WallShape::PlaneBeads { .. })
+    });
+    Some(std::iter::once(own).chain(beads.map(|(k, _)| k)).collect())
+}
+
 /// The four interleaved sub-lattices of a drum's glued beads, as walls `<drum>_beads_<k parity><j parity>`.
 ///
 /// Seed 000 §3.4 builds its tumbler wall from particles "loaded along a cylindrical geometry": a bumpy wall on
@@ -432,4 +444,53 @@ fn plane_bead_walls(
             },
         })
         .collect())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::engine::particles::SpeciesId;
+
+    /// A drum's name stands for the drum and its four bead sub-lattices, not for another wall whose name begins
+    /// alike; a plane without beads for itself alone.
+    #[test]
+    fn a_wall_name_stands_for_the_wall_and_its_glued_beads() {
+        let frame = RotatingFrame::new(Vec3::zeros(), Vec3::z(), 1.0);
+        let plane = |name: &str| Wall {
+            name: name.into(),
+            species: SpeciesId(0),
+            shape: WallShape::Plane {
+                point_m: Vec3::zeros(),
+                normal: Vec3::y(),
+            },
+        };
+        let bead = |p: u8| Wall {
+            name: format!("drum_beads_{}{}", p / 2, p % 2),
+            species: SpeciesId(0),
+            shape: WallShape::GluedBeads {
+                frame,
+                radius_m: 0.1,
+                bead_radius_m: 0.001,
+                count_around: 200,
+                axial_spacing_m: 0.002,
+                parity: [p / 2, p % 2],
+            },
+        };
+        let mut walls = vec![
+            plane("floor"),
+            Wall {
+                name: "drum".into(),
+                species: SpeciesId(0),
+                shape: WallShape::RotatingCylinder { frame, radius_m: 0.1 },
+            },
+        ];
+        walls.extend((0..4).map(bead));
+        walls.push(plane("drum_beads_lid"));
+        walls.push(plane("drum2"));
+        assert_eq!(walls_named(&walls, "drum"), Some(vec![1, 2, 3, 4, 5]));
+        assert_eq!(walls_named(&walls, "floor"), Some(vec![0]));
+        assert_eq!(walls_named(&walls, "drum2"), Some(vec![7]));
+        assert_eq!(walls_named(&walls, "drum_beads_01"), Some(vec![3]));
+        assert_eq!(walls_named(&walls, "lid"), None);
+    }
 }
