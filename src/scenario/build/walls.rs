@@ -289,7 +289,7 @@ fn glued_bead_walls(
             ),
         ));
     }
-    if beads.count_around < 4 || beads.count_around % 2 != 0 {
+    if beads.count_around < 4 || !beads.count_around.is_multiple_of(2) {
         return Err(c.fail(
             key("count_around"),
             format!(
