@@ -143,6 +143,8 @@ pub struct Criteria<'a> {
     pub range: Reach,
     pub walls: &'a [Wall],
     pub wall_angle: &'a [f64],
+    /// (sine, cosine) of each `wall_angle` ([`crate::engine::geometry::turns`]).
+    pub wall_turn: &'a [(f64, f64)],
     pub pseudo_2d: bool,
 }
 
@@ -164,7 +166,9 @@ impl Criteria<'_> {
         } else {
             ri + self.range.wall_gap_m + self.skin_m
         };
-        wall.proximity(&self.position[i], self.wall_angle[w as usize]).gap_m < reach
+        wall.proximity_turned(&self.position[i], self.wall_turn[w as usize])
+            .gap_m
+            < reach
     }
 }
 
@@ -403,6 +407,7 @@ impl NeighborList {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::engine::geometry::turns;
 
     /// Uniform numbers in [0, 1) from a 64-bit LCG seeded with `seed` (reproducible test positions and radii).
     fn uniform(seed: u64) -> impl FnMut() -> f64 {
@@ -423,10 +428,12 @@ mod tests {
         use crate::engine::geometry::{Wall, WallShape};
         use crate::engine::particles::SpeciesId;
         let domain = Domain::new(Vec3::zeros(), Vec3::new(0.3, 0.3, 0.3), [true, false, false]);
-        let plane = |point: Vec3, normal: Vec3| Wall {
-            name: "plane".into(),
-            species: SpeciesId(0),
-            shape: WallShape::Plane { point_m: point, normal },
+        let plane = |point: Vec3, normal: Vec3| {
+            Wall::new(
+                "plane".into(),
+                SpeciesId(0),
+                WallShape::Plane { point_m: point, normal },
+            )
         };
         let walls = [
             plane(Vec3::zeros(), Vec3::y()),
@@ -453,6 +460,7 @@ mod tests {
             range: reach,
             walls: &walls,
             wall_angle: &angles,
+            wall_turn: &turns(&angles),
             pseudo_2d: false,
         };
         let mut outer = NeighborList::default();
@@ -510,6 +518,7 @@ mod tests {
             range: Reach::default(),
             walls: &[],
             wall_angle: &[],
+            wall_turn: &[],
             pseudo_2d: false,
         };
         let team = Team::new(2);
@@ -550,6 +559,7 @@ mod tests {
                 range: Reach::default(),
                 walls: &[],
                 wall_angle: &[],
+                wall_turn: &[],
                 pseudo_2d: false,
             };
             let mut list = NeighborList::default();

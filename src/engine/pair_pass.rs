@@ -24,7 +24,7 @@ use super::Vec3;
 use super::channels::{ChannelGroups, ChannelsMut, ScalarFlows};
 use super::cohesion::{Bond, BridgeConstants, Cohesion};
 use super::contacts::{AlignedHistory, ColumnsMut};
-use super::geometry::Wall;
+use super::geometry::{Wall, turns};
 use super::heat::HeatConfig;
 use super::heat_ledger::FixedPointSum;
 use super::integrate::{InverseInertia, half_kick_one};
@@ -188,7 +188,8 @@ struct Context<'a> {
     species: &'a [SpeciesId],
     inv_mass_per_kg: &'a [f64],
     inv_inertia_per_kg_m2: &'a [f64],
-    wall_angle: &'a [f64],
+    /// (sine, cosine) of each wall's turn angle this step.
+    wall_turn: &'a [(f64, f64)],
     dt_s: f64,
     kick: Option<HalfKick>,
     /// The force and torque arrays are all zero on entry (the previous pass fused the next drift).
@@ -237,7 +238,7 @@ impl<'a> Context<'a> {
         config: &'a SimConfig,
         p: &'a Particles,
         inverse: &'a InverseInertia,
-        wall_angle: &'a [f64],
+        wall_turn: &'a [(f64, f64)],
         dt_s: f64,
         kick: Option<HalfKick>,
         accumulators_zeroed: bool,
@@ -255,7 +256,7 @@ impl<'a> Context<'a> {
             species: &p.species,
             inv_mass_per_kg: &inverse.inv_mass_per_kg,
             inv_inertia_per_kg_m2: &inverse.inv_inertia_per_kg_m2,
-            wall_angle,
+            wall_turn,
             dt_s,
             kick,
             accumulators_zeroed,
@@ -728,11 +729,12 @@ pub fn compute_pair_forces(
     let mut temperature = std::mem::take(&mut p.temperature_k);
     let mut channels = std::mem::take(&mut p.channels);
     let channels_on = channels.is_on();
+    let wall_turn = turns(wall_angle);
     let ctx = Context::new(
         config,
         p,
         inverse,
-        wall_angle,
+        &wall_turn,
         dt_s,
         kick,
         accumulators_zeroed,
@@ -826,11 +828,12 @@ pub fn add_wall_forces(
     cohesion_n: &mut [Vec3],
 ) {
     // (Channels off: this pass only reads the forces, and leaves the history and the channels untouched.)
+    let wall_turn = turns(wall_angle);
     let ctx = Context::new(
         config,
         p,
         inverse,
-        wall_angle,
+        &wall_turn,
         dt_s,
         None,
         false,

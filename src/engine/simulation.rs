@@ -16,6 +16,7 @@ use super::cohesion::CohesionEvents;
 pub use super::config::SimConfig;
 use super::contacts::AlignedHistory;
 use super::gas::coupled::GasCoupling;
+use super::geometry::turns;
 use super::heat_ledger::HeatLedger;
 use super::integrate::{InverseInertia, find_lost, kick_drift};
 use super::liquid::{BridgeCache, step_liquid};
@@ -817,6 +818,7 @@ impl Simulation {
     fn build_lists(&mut self, searched: bool, team: &Team) {
         self.work.drift_bound_m = 0.0;
         let c = &self.config;
+        let wall_turn = turns(&self.wall_angle_rad);
         let outer = Criteria {
             domain: &c.domain,
             position: &self.particles.position_m,
@@ -825,6 +827,7 @@ impl Simulation {
             range: c.reach(),
             walls: &c.walls,
             wall_angle: &self.wall_angle_rad,
+            wall_turn: &wall_turn,
             pseudo_2d: c.pseudo_2d,
         };
         if !self.two_level() {

@@ -5,4 +5,4 @@ pub mod domain;
 pub mod walls;
 
 pub use domain::{Axis, Domain, Gravity, GravityFlip};
-pub use walls::{RotatingFrame, Wall, WallProximity, WallShape};
+pub use walls::{RotatingFrame, Wall, WallProximity, WallShape, turns};

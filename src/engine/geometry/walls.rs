@@ -98,6 +98,17 @@ pub enum WallShape {
     },
 }
 
+/// The (sine, cosine) of each wall's turn angle, for [`Wall::proximity_turned`].
+pub fn turns(wall_angle_rad: &[f64]) -> Vec<(f64, f64)> {
+    wall_angle_rad.iter().map(|a| a.sin_cos()).collect()
+}
+
+/// The angle between neighbouring beads around a drum of `count_around`, rad.
+#[inline]
+fn bead_step_rad(count_around: u32) -> f64 {
+    2.0 * std::f64::consts::PI / f64::from(count_around)
+}
+
 /// The integer nearest to `t` whose parity is `parity` (0 even, 1 odd), as a float.
 #[inline]
 fn nearest_with_parity(t: f64, parity: u8) -> f64 {
@@ -110,7 +121,14 @@ pub struct Wall {
     pub name: String,
     pub species: SpeciesId,
     pub shape: WallShape,
+    /// Glued beads around a drum: the (sine, cosine) of each bead's body angle kΔθ, at index k + `BEAD_INDEX_OFFSET`
+    /// (k from −count/2 − 1 to count/2 + 1), computed once as [`Wall::proximity_turned`] would compute them per call
+    /// (the same bits); empty for other shapes.
+    bead_direction: Vec<(f64, f64)>,
 }
+
+/// The offset of k = 0 in [`Wall`]'s bead direction table, beyond the count/2 that k can reach.
+const BEAD_INDEX_OFFSET: i64 = 2;
 
 /// A particle touching (or near) a wall.
 #[derive(Debug, Clone, Copy)]
@@ -126,6 +144,24 @@ pub struct WallProximity {
 }
 
 impl Wall {
+    /// A wall of `shape` called `name`, made of `species`.
+    pub fn new(name: String, species: SpeciesId, shape: WallShape) -> Self {
+        let bead_direction = match shape {
+            WallShape::GluedBeads { count_around, .. } => {
+                let step_rad = bead_step_rad(count_around);
+                let half = i64::from(count_around / 2) + BEAD_INDEX_OFFSET;
+                (-half..=half).map(|k| (k as f64 * step_rad).sin_cos()).collect()
+            }
+            _ => Vec::new(),
+        };
+        Wall {
+            name,
+            species,
+            shape,
+            bead_direction,
+        }
+    }
+
     /// A static plane whose normal is along z: in pseudo-2-D runs (no motion along z) a particle's gap to it never
     /// changes.
     pub fn is_plane_normal_to_z(&self) -> bool {
@@ -196,6 +232,13 @@ impl Wall {
     /// Gap, normal and wall velocity for a particle centre at `x` when the wall has turned by `angle_rad`.
     #[inline]
     pub fn proximity(&self, x: &Vec3, angle_rad: f64) -> WallProximity {
+        self.proximity_turned(x, angle_rad.sin_cos())
+    }
+
+    /// [`Wall::proximity`] with the turn angle's (sine, cosine) `turn` given: the passes over all particles take it
+    /// once per wall and step (`angle_rad.sin_cos()`, the same bits) instead of once per particle.
+    #[inline]
+    pub fn proximity_turned(&self, x: &Vec3, turn: (f64, f64)) -> WallProximity {
         match &self.shape {
             WallShape::Plane { point_m, normal } => WallProximity {
                 gap_m: (x - point_m).dot(normal),
@@ -222,7 +265,6 @@ impl Wall {
                 end_m,
                 half_thickness_m,
             } => {
-                let turn = angle_rad.sin_cos();
                 let (u, v) = frame.body_coordinates(x, turn);
                 let (su, sv) = (end_m[0] - start_m[0], end_m[1] - start_m[1]);
                 let len2 = su * su + sv * sv;
@@ -276,13 +318,14 @@ impl Wall {
                 axial_spacing_m,
                 parity,
             } => {
-                let turn = angle_rad.sin_cos();
                 let (u, v) = frame.body_coordinates(x, turn);
-                let step_rad = 2.0 * std::f64::consts::PI / f64::from(*count_around);
-                let theta = nearest_with_parity(v.atan2(u) / step_rad, parity[0]) * step_rad;
+                let step_rad = bead_step_rad(*count_around);
+                let k = nearest_with_parity(v.atan2(u) / step_rad, parity[0]);
                 let axial_m = (x - frame.axis_point_m).dot(&frame.axis);
                 let ring_m = nearest_with_parity(axial_m / axial_spacing_m, parity[1]) * axial_spacing_m;
-                let (s, co) = theta.sin_cos();
+                // (sin, cos) of kΔθ: |k| ≤ count/2 + 1 since atan2 is within ±π.
+                let (s, co) =
+                    self.bead_direction[(k as i64 + i64::from(*count_around / 2) + BEAD_INDEX_OFFSET) as usize];
                 let centre =
                     frame.axis_point_m + frame.axis * ring_m + frame.world_vector(radius_m * co, radius_m * s, turn);
                 let d = x - centre;
@@ -312,11 +355,11 @@ mod tests {
     #[test]
     fn cylinder_gap_normal_and_surface_velocity() {
         let frame = RotatingFrame::new(Vec3::zeros(), Vec3::z(), 2.0);
-        let wall = Wall {
-            name: "drum".into(),
-            species: SpeciesId(0),
-            shape: WallShape::RotatingCylinder { frame, radius_m: 1.0 },
-        };
+        let wall = Wall::new(
+            "drum".into(),
+            SpeciesId(0),
+            WallShape::RotatingCylinder { frame, radius_m: 1.0 },
+        );
         let p = wall.proximity(&Vec3::new(0.0, -0.9, 0.3), 0.0);
         assert!((p.gap_m - 0.1).abs() < 1e-12);
         assert!((p.normal - Vec3::new(0.0, 1.0, 0.0)).norm() < 1e-12);
@@ -327,28 +370,74 @@ mod tests {
     /// A glued bead is a particle for the contact law's R* (R_i R_b / (R_i + R_b)); a smooth wall an infinite one.
     #[test]
     fn a_glued_bead_contact_takes_the_pair_radius() {
-        let plane = |bead_radius_m: Option<f64>| Wall {
-            name: "floor".into(),
-            species: SpeciesId(0),
-            shape: match bead_radius_m {
-                Some(bead_radius_m) => WallShape::PlaneBeads {
-                    point_m: Vec3::zeros(),
-                    normal: Vec3::z(),
-                    e1: Vec3::x(),
-                    e2: Vec3::y(),
-                    bead_radius_m,
-                    spacing_m: [0.1, 0.1],
-                    parity: [0, 0],
+        let plane = |bead_radius_m: Option<f64>| {
+            Wall::new(
+                "floor".into(),
+                SpeciesId(0),
+                match bead_radius_m {
+                    Some(bead_radius_m) => WallShape::PlaneBeads {
+                        point_m: Vec3::zeros(),
+                        normal: Vec3::z(),
+                        e1: Vec3::x(),
+                        e2: Vec3::y(),
+                        bead_radius_m,
+                        spacing_m: [0.1, 0.1],
+                        parity: [0, 0],
+                    },
+                    None => WallShape::Plane {
+                        point_m: Vec3::zeros(),
+                        normal: Vec3::z(),
+                    },
                 },
-                None => WallShape::Plane {
-                    point_m: Vec3::zeros(),
-                    normal: Vec3::z(),
-                },
-            },
+            )
         };
         assert_eq!(plane(None).contact_radius_m(0.002), 0.002);
         assert!((plane(Some(0.002)).contact_radius_m(0.002) - 0.001).abs() < 1e-15);
         assert!((plane(Some(0.001)).contact_radius_m(0.002) - 0.002 / 3.0).abs() < 1e-15);
+    }
+
+    /// Every direction around the drum, ±π included, at any turn: each sub-lattice's gap is the distance to its
+    /// nearest bead found by trying them all (the bead direction table covers every index the lookup can reach).
+    #[test]
+    fn glued_bead_gaps_all_the_way_round_match_a_search_of_every_bead() {
+        for count_around in [8u32, 36, 90] {
+            let frame = RotatingFrame::new(Vec3::zeros(), Vec3::z(), 1.0);
+            let step = 2.0 * std::f64::consts::PI / f64::from(count_around);
+            for parity in 0..2u8 {
+                let wall = Wall::new(
+                    "beads".into(),
+                    SpeciesId(0),
+                    WallShape::GluedBeads {
+                        frame,
+                        radius_m: 1.0,
+                        bead_radius_m: 0.01,
+                        count_around,
+                        axial_spacing_m: 0.5,
+                        parity: [parity, 0],
+                    },
+                );
+                for angle_rad in [0.0, 0.3, -2.0, std::f64::consts::PI] {
+                    let mut directions: Vec<f64> =
+                        (0..720).map(|n| f64::from(n) * std::f64::consts::PI / 360.0).collect();
+                    directions.extend([std::f64::consts::PI - angle_rad, -std::f64::consts::PI - angle_rad]);
+                    for phi in directions {
+                        let x = Vec3::new(0.9 * phi.cos(), 0.9 * phi.sin(), 0.0);
+                        let nearest = (0..count_around)
+                            .filter(|k| k % 2 == u32::from(parity))
+                            .map(|k| {
+                                let theta = f64::from(k) * step + angle_rad;
+                                (x - Vec3::new(theta.cos(), theta.sin(), 0.0)).norm()
+                            })
+                            .fold(f64::INFINITY, f64::min);
+                        let gap = wall.proximity_turned(&x, angle_rad.sin_cos()).gap_m;
+                        assert!(
+                            (gap - (nearest - 0.01)).abs() < 1e-12,
+                            "{count_around} {parity} {angle_rad} {phi}"
+                        );
+                    }
+                }
+            }
+        }
     }
 
     /// The four sub-lattices together are the whole bead lattice: the nearest of their beads is the nearest bead,
@@ -357,17 +446,19 @@ mod tests {
     fn glued_beads_are_the_nearest_bead_of_each_sub_lattice() {
         let frame = RotatingFrame::new(Vec3::zeros(), Vec3::z(), 2.0);
         let lattice: Vec<Wall> = (0..4u8)
-            .map(|p| Wall {
-                name: format!("beads_{p}"),
-                species: SpeciesId(0),
-                shape: WallShape::GluedBeads {
-                    frame,
-                    radius_m: 1.0,
-                    bead_radius_m: 0.05,
-                    count_around: 36,
-                    axial_spacing_m: 0.2,
-                    parity: [p / 2, p % 2],
-                },
+            .map(|p| {
+                Wall::new(
+                    format!("beads_{p}"),
+                    SpeciesId(0),
+                    WallShape::GluedBeads {
+                        frame,
+                        radius_m: 1.0,
+                        bead_radius_m: 0.05,
+                        count_around: 36,
+                        axial_spacing_m: 0.2,
+                        parity: [p / 2, p % 2],
+                    },
+                )
             })
             .collect();
         let step = 2.0 * std::f64::consts::PI / 36.0;
@@ -397,18 +488,20 @@ mod tests {
     #[test]
     fn plane_beads_are_the_nearest_bead_of_each_sub_lattice() {
         let lattice: Vec<Wall> = (0..4u8)
-            .map(|p| Wall {
-                name: format!("floor_beads_{p}"),
-                species: SpeciesId(0),
-                shape: WallShape::PlaneBeads {
-                    point_m: Vec3::new(0.0, 0.1, 0.0),
-                    normal: Vec3::y(),
-                    e1: Vec3::x(),
-                    e2: -Vec3::z(),
-                    bead_radius_m: 0.5,
-                    spacing_m: [1.0, 2.0],
-                    parity: [p / 2, p % 2],
-                },
+            .map(|p| {
+                Wall::new(
+                    format!("floor_beads_{p}"),
+                    SpeciesId(0),
+                    WallShape::PlaneBeads {
+                        point_m: Vec3::new(0.0, 0.1, 0.0),
+                        normal: Vec3::y(),
+                        e1: Vec3::x(),
+                        e2: -Vec3::z(),
+                        bead_radius_m: 0.5,
+                        spacing_m: [1.0, 2.0],
+                        parity: [p / 2, p % 2],
+                    },
+                )
             })
             .collect();
         // Above bead i = 3 (odd), j = -2 (even: z = +4), 0.3 m off along x, 1.6 m above the plane.
@@ -426,16 +519,16 @@ mod tests {
     #[test]
     fn baffle_turns_with_its_frame() {
         let frame = RotatingFrame::new(Vec3::zeros(), Vec3::z(), 1.0);
-        let wall = Wall {
-            name: "b".into(),
-            species: SpeciesId(0),
-            shape: WallShape::Baffle {
+        let wall = Wall::new(
+            "b".into(),
+            SpeciesId(0),
+            WallShape::Baffle {
                 frame,
                 start_m: [0.5, 0.0],
                 end_m: [1.0, 0.0],
                 half_thickness_m: 0.01,
             },
-        };
+        );
         // At angle 0 the plate lies on +x; a point above it at (0.75, 0.1).
         let p0 = wall.proximity(&Vec3::new(0.75, 0.1, 0.0), 0.0);
         assert!((p0.gap_m - 0.09).abs() < 1e-12);

@@ -66,7 +66,7 @@ impl Context<'_> {
             for (offset, &w) in wall_ids.iter().enumerate() {
                 let k = first_slot + offset;
                 let wall = &self.config.walls[w as usize];
-                let prox = wall.proximity(&x, self.wall_angle[w as usize]);
+                let prox = wall.proximity_turned(&x, self.wall_turn[w as usize]);
                 let overlap = ri - prox.gap_m;
                 if overlap <= 0.0 {
                     hist.release_as::<P>(k);
@@ -169,7 +169,7 @@ impl Context<'_> {
     ) -> WallSlotResult {
         let ri = self.radius_m[i];
         let wall = &self.config.walls[w as usize];
-        let prox = wall.proximity(&x, self.wall_angle[w as usize]);
+        let prox = wall.proximity_turned(&x, self.wall_turn[w as usize]);
         let overlap = ri - prox.gap_m;
         let mut flows = ScalarFlows::ZERO;
         let contact = if overlap <= 0.0 {

@@ -31,11 +31,11 @@ pub(super) fn build_walls(
                     for (side, point, sign) in [("lo", domain.lo_m, 1.0), ("hi", domain.hi_m, -1.0)] {
                         let mut normal = Vec3::zeros();
                         normal[axis] = sign;
-                        walls.push(Wall {
-                            name: format!("box_{axis_name}_{side}"),
-                            species: id,
-                            shape: WallShape::Plane { point_m: point, normal },
-                        });
+                        walls.push(Wall::new(
+                            format!("box_{axis_name}_{side}"),
+                            id,
+                            WallShape::Plane { point_m: point, normal },
+                        ));
                     }
                 }
             }
@@ -49,14 +49,14 @@ pub(super) fn build_walls(
                 let id = c.species(&format!("walls[{k}].plane.species"), species, s)?;
                 c.finite3(&format!("walls[{k}].plane.point_m"), point_m)?;
                 let n = c.unit3(&format!("walls[{k}].plane.normal"), normal)?;
-                walls.push(Wall {
-                    name: name.clone(),
-                    species: id,
-                    shape: WallShape::Plane {
+                walls.push(Wall::new(
+                    name.clone(),
+                    id,
+                    WallShape::Plane {
                         point_m: Vec3::from(*point_m),
                         normal: n,
                     },
-                });
+                ));
                 if let Some(beads) = glued_beads {
                     walls.extend(plane_bead_walls(
                         c,
@@ -105,14 +105,14 @@ pub(super) fn build_walls(
                 }
                 let omega = d.rotation_rpm * 2.0 * PI / 60.0;
                 let frame = RotatingFrame::new(Vec3::from(d.axis_point_m), axis, omega);
-                walls.push(Wall {
-                    name: d.name.clone(),
-                    species: id,
-                    shape: WallShape::RotatingCylinder {
+                walls.push(Wall::new(
+                    d.name.clone(),
+                    id,
+                    WallShape::RotatingCylinder {
                         frame,
                         radius_m: d.radius_m,
                     },
-                });
+                ));
                 if let Some(beads) = &d.glued_beads {
                     walls.extend(glued_bead_walls(c, spec, domain, k, d, beads, frame, id)?);
                 }
@@ -130,16 +130,16 @@ pub(super) fn build_walls(
                                 ),
                             ));
                         }
-                        walls.push(Wall {
-                            name: format!("{}_baffle_{b}_{s}", d.name),
-                            species: id,
-                            shape: WallShape::Baffle {
+                        walls.push(Wall::new(
+                            format!("{}_baffle_{b}_{s}", d.name),
+                            id,
+                            WallShape::Baffle {
                                 frame,
                                 start_m: start,
                                 end_m: end,
                                 half_thickness_m: half,
                             },
-                        });
+                        ));
                     }
                 }
             }
@@ -324,17 +324,19 @@ fn glued_bead_walls(
     let axis = Vec3::from(d.axis).normalize();
     check_periodic_spacing(c, domain, axis, beads.axial_spacing_m, &key("axial_spacing_m"), "rings")?;
     Ok((0..4u8)
-        .map(|p| Wall {
-            name: format!("{}_beads_{}{}", d.name, p / 2, p % 2),
-            species,
-            shape: WallShape::GluedBeads {
-                frame,
-                radius_m: d.radius_m,
-                bead_radius_m: beads.radius_m,
-                count_around: beads.count_around,
-                axial_spacing_m: beads.axial_spacing_m,
-                parity: [p / 2, p % 2],
-            },
+        .map(|p| {
+            Wall::new(
+                format!("{}_beads_{}{}", d.name, p / 2, p % 2),
+                species,
+                WallShape::GluedBeads {
+                    frame,
+                    radius_m: d.radius_m,
+                    bead_radius_m: beads.radius_m,
+                    count_around: beads.count_around,
+                    axial_spacing_m: beads.axial_spacing_m,
+                    parity: [p / 2, p % 2],
+                },
+            )
         })
         .collect())
 }
@@ -430,18 +432,20 @@ fn plane_bead_walls(
     check_periodic_spacing(c, domain, e1, beads.spacing_m[0], &key("spacing_m"), "beads")?;
     check_periodic_spacing(c, domain, e2, beads.spacing_m[1], &key("spacing_m"), "beads")?;
     Ok((0..4u8)
-        .map(|p| Wall {
-            name: format!("{name}_beads_{}{}", p / 2, p % 2),
-            species,
-            shape: WallShape::PlaneBeads {
-                point_m,
-                normal,
-                e1,
-                e2,
-                bead_radius_m: beads.radius_m,
-                spacing_m: beads.spacing_m,
-                parity: [p / 2, p % 2],
-            },
+        .map(|p| {
+            Wall::new(
+                format!("{name}_beads_{}{}", p / 2, p % 2),
+                species,
+                WallShape::PlaneBeads {
+                    point_m,
+                    normal,
+                    e1,
+                    e2,
+                    bead_radius_m: beads.radius_m,
+                    spacing_m: beads.spacing_m,
+                    parity: [p / 2, p % 2],
+                },
+            )
         })
         .collect())
 }
@@ -456,33 +460,37 @@ mod tests {
     #[test]
     fn a_wall_name_stands_for_the_wall_and_its_glued_beads() {
         let frame = RotatingFrame::new(Vec3::zeros(), Vec3::z(), 1.0);
-        let plane = |name: &str| Wall {
-            name: name.into(),
-            species: SpeciesId(0),
-            shape: WallShape::Plane {
-                point_m: Vec3::zeros(),
-                normal: Vec3::y(),
-            },
+        let plane = |name: &str| {
+            Wall::new(
+                name.into(),
+                SpeciesId(0),
+                WallShape::Plane {
+                    point_m: Vec3::zeros(),
+                    normal: Vec3::y(),
+                },
+            )
         };
-        let bead = |p: u8| Wall {
-            name: format!("drum_beads_{}{}", p / 2, p % 2),
-            species: SpeciesId(0),
-            shape: WallShape::GluedBeads {
-                frame,
-                radius_m: 0.1,
-                bead_radius_m: 0.001,
-                count_around: 200,
-                axial_spacing_m: 0.002,
-                parity: [p / 2, p % 2],
-            },
+        let bead = |p: u8| {
+            Wall::new(
+                format!("drum_beads_{}{}", p / 2, p % 2),
+                SpeciesId(0),
+                WallShape::GluedBeads {
+                    frame,
+                    radius_m: 0.1,
+                    bead_radius_m: 0.001,
+                    count_around: 200,
+                    axial_spacing_m: 0.002,
+                    parity: [p / 2, p % 2],
+                },
+            )
         };
         let mut walls = vec![
             plane("floor"),
-            Wall {
-                name: "drum".into(),
-                species: SpeciesId(0),
-                shape: WallShape::RotatingCylinder { frame, radius_m: 0.1 },
-            },
+            Wall::new(
+                "drum".into(),
+                SpeciesId(0),
+                WallShape::RotatingCylinder { frame, radius_m: 0.1 },
+            ),
         ];
         walls.extend((0..4).map(bead));
         walls.push(plane("drum_beads_lid"));
