@@ -64,6 +64,7 @@ fn lists(c: &mut Criterion) {
         range: Reach::default(),
         walls: &[],
         wall_angle: &[],
+        wall_turn: &[],
         pseudo_2d: false,
     };
     let inner = Criteria {

@@ -319,7 +319,8 @@ pub fn fit_line(x: &[f64], y: &[f64]) -> Option<LineFit> {
     let sxx: f64 = x.iter().map(|x| (x - mx) * (x - mx)).sum();
     let sxy: f64 = x.iter().zip(&y).map(|(x, y)| (x - mx) * (y - my)).sum();
     let syy: f64 = y.iter().map(|y| (y - my) * (y - my)).sum();
-    if !(sxx > 0.0) {
+    // (Also no line when sxx is NaN.)
+    if sxx.partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater) {
         return None;
     }
     let slope = sxy / sxx;

@@ -202,7 +202,7 @@ pub fn dry(
     let pool_m3 = liquid_pools_m3(p, list, history);
     let blocked = &gas.solver.config.blocked;
     let mut rates: Vec<Option<Rate>> = Vec::with_capacity(p.len());
-    for i in 0..p.len() {
+    for (i, &pool_i_m3) in pool_m3.iter().enumerate() {
         let c = gas.fluid.cell_of(&p.position_m[i]);
         if blocked.get(c).copied().unwrap_or(false) {
             rates.push(None);
@@ -218,7 +218,7 @@ pub fn dry(
             cell: c,
             e_kg_per_s: a * saturation_pressure_pa(t) / d,
             f_rho_kg_per_s: a * pressure_per_density * rho / d,
-            available_kg_per_s: pool_m3[i] * config.liquid_density_kg_per_m3 / dt_s,
+            available_kg_per_s: pool_i_m3 * config.liquid_density_kg_per_m3 / dt_s,
             floor_kg_per_s: SMALLEST_BRIDGE * p.radius_m[i].powi(3) * config.liquid_density_kg_per_m3 / dt_s,
             fixed: None,
         }));
