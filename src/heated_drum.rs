@@ -50,15 +50,8 @@ pub fn heated_drum(config: &SimConfig) -> Option<HeatedDrum> {
             bead_radius_m: config
                 .walls
                 .iter()
-                .filter_map(|other| match other.shape {
-                    WallShape::GluedBeads {
-                        frame: f,
-                        radius_m: r,
-                        bead_radius_m,
-                        ..
-                    } if f == *frame && r == *radius_m => Some(bead_radius_m),
-                    _ => None,
-                })
+                .filter(|other| other.glued_to.as_deref() == Some(wall.name.as_str()))
+                .filter_map(|other| other.bead_radius_m())
                 .fold(0.0, f64::max),
             angular_speed_rad_per_s: frame.angular_velocity_rad_per_s.abs(),
             length_m: along.map_or(f64::NAN, |k| config.domain.hi_m[k] - config.domain.lo_m[k]),

@@ -163,6 +163,31 @@ seed: 1
     );
 }
 
+/// A heated drum's beads are found as its own (`Wall::glued_to`), for the contact arc that E5's h_w divides by: the
+/// bead radius on a beaded drum, 0 on a smooth one; another drum's beads do not count.
+#[test]
+fn a_heated_drum_knows_its_own_glued_beads() {
+    let heated = |beads: &str, second_drum: &str| {
+        let yaml = drum(beads, 0.01)
+            .replace(
+                "friction_coefficient: 0.4 }",
+                "friction_coefficient: 0.4, thermal_conductivity_w_per_m_k: 1.0, heat_capacity_j_per_kg_k: 800.0 }",
+            )
+            .replace(
+                "friction_coefficient: 1.0 }",
+                "friction_coefficient: 1.0, thermal_conductivity_w_per_m_k: 1.0, heat_capacity_j_per_kg_k: 800.0 }",
+            )
+            .replace("fill:", &format!("{second_drum}fill:"))
+            + "heat: { initial_temperature_k: 300.0, walls: { drum: { temperature_k: 400.0 } } }\n";
+        granflow::heated_drum::heated_drum(&built(&yaml).config).expect("one heated drum")
+    };
+    assert_eq!(heated(BEADS, "").bead_radius_m, 0.0015);
+    assert_eq!(heated("", "").bead_radius_m, 0.0);
+    let other = "  - drum: { name: outer, species: wall, axis_point_m: [0.0, 0.0, 0.0], axis: [0.0, 0.0, 1.0], radius_m: 0.0205, rotation_rpm: 6.0, glued_beads: { radius_m: 0.0002, count_around: 40, axial_spacing_m: 0.00315 } }\n";
+    let drum = heated("", other);
+    assert_eq!((drum.bead_radius_m, drum.wall), (0.0, 0));
+}
+
 #[test]
 fn a_drum_with_glued_beads_resumes_bit_for_bit() {
     let tmp = tempfile::tempdir().unwrap();

@@ -121,6 +121,9 @@ pub struct Wall {
     pub name: String,
     pub species: SpeciesId,
     pub shape: WallShape,
+    /// The name of the wall whose glued beads this wall is (`None` for a wall of its own): a name given for a
+    /// drum or plane in the scenario stands for its beads too (heat, cohesion switches, the heated drum's arc).
+    pub glued_to: Option<String>,
     /// Glued beads around a drum: the (sine, cosine) of each bead's body angle kΔθ, at index k + `BEAD_INDEX_OFFSET`
     /// (k from −count/2 − 1 to count/2 + 1), computed once as [`Wall::proximity_turned`] would compute them per call
     /// (the same bits); empty for other shapes.
@@ -158,7 +161,16 @@ impl Wall {
             name,
             species,
             shape,
+            glued_to: None,
             bead_direction,
+        }
+    }
+
+    /// This wall as glued beads of the wall called `parent`.
+    pub fn glued_to(self, parent: &str) -> Self {
+        Wall {
+            glued_to: Some(parent.to_string()),
+            ..self
         }
     }
 

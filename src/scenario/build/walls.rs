@@ -247,14 +247,14 @@ fn baffle_segments(
 }
 
 /// The walls a wall's name in the scenario stands for: the wall of that name and, for a drum or a plane with glued
-/// beads, its four bead sub-lattices (`<name>_beads_<k><j>`), which are part of it: a heated drum heats through its
-/// beads too, and `cohesion_off` for a wall holds for its beads. `None` when no wall has the name.
+/// beads, its four bead sub-lattices (the walls [`Wall::glued_to`] it), which are part of it: a heated drum heats
+/// through its beads too, and `cohesion_off` for a wall holds for its beads. `None` when no wall has the name.
 pub(in crate::scenario) fn walls_named(walls: &[Wall], name: &str) -> Option<Vec<usize>> {
     let own = walls.iter().position(|w| w.name == name)?;
-    let prefix = format!("{name}_beads_");
-    let beads = walls.iter().enumerate().filter(|(_, w)| {
-        w.name.starts_with(&prefix) && matches!(w.shape, WallShape::GluedBeads { .. } | WallShape::PlaneBeads { .. })
-    });
+    let beads = walls
+        .iter()
+        .enumerate()
+        .filter(|(_, w)| w.glued_to.as_deref() == Some(name));
     Some(std::iter::once(own).chain(beads.map(|(k, _)| k)).collect())
 }
 
@@ -337,6 +337,7 @@ fn glued_bead_walls(
                     parity: [p / 2, p % 2],
                 },
             )
+            .glued_to(&d.name)
         })
         .collect())
 }
@@ -446,6 +447,7 @@ fn plane_bead_walls(
                     parity: [p / 2, p % 2],
                 },
             )
+            .glued_to(name)
         })
         .collect())
 }
@@ -483,6 +485,7 @@ mod tests {
                     parity: [p / 2, p % 2],
                 },
             )
+            .glued_to("drum")
         };
         let mut walls = vec![
             plane("floor"),
