@@ -163,6 +163,66 @@ seed: 1
     );
 }
 
+/// One sphere (1 mm, 2500 kg/m³) above the bead at the origin of a floor of glued beads of the same size, with no
+/// gravity: the scenario with `cohesion` and the sphere's `z0` and downward speed `v0`.
+fn sphere_over_a_bead(cohesion: &str, z0: f64, v0: f64, end_s: f64) -> String {
+    format!(
+        r#"name: bead-cohesion
+domain: {{ lo_m: [-0.01, -0.01, -0.002], hi_m: [0.01, 0.01, 0.01], periodic: [false, false, false] }}
+gravity: {{ vector_m_per_s2: [0.0, 0.0, 0.0] }}
+species:
+  - {{ name: glass, radius_m: 0.001, density_kg_per_m3: 2500.0, youngs_modulus_pa: 1.0e8, poisson_ratio: 0.3, friction_coefficient: 0.5 }}
+contact: {{ normal: {{ hertz: {{ restitution: 0.9 }} }}, tangential: mindlin }}
+cohesion: {cohesion}
+walls:
+  - plane: {{ name: floor, species: glass, point_m: [0.0, 0.0, 0.0], normal: [0.0, 0.0, 1.0], glued_beads: {{ radius_m: 0.001, spacing_m: [0.004, 0.004] }} }}
+fill:
+  - explicit: {{ species: glass, positions_m: [[0.0, 0.0, {z0}]], velocities_m_per_s: [[0.0, 0.0, -{v0}]] }}
+time: {{ dt_fraction_of_contact_time: 0.05, end_time_s: {end_s} }}
+seed: 1
+"#
+    )
+}
+
+/// A glued bead attracts as the glued particle it is: Hamaker's force at a 1 µm gap is A R*/(6 D²) with the pair's
+/// R* (half a flat wall's for equal radii), and a square well to it is the pair's, as deep as between particles (a
+/// flat wall's is twice as deep: seed 001 §6.2.4.2) and reaching (ratio − 1)(R_i + r_b) beyond contact.
+#[test]
+fn a_glued_bead_attracts_as_a_glued_particle() {
+    let (r, mass_kg) = (0.001, 2500.0 * 4.0 / 3.0 * std::f64::consts::PI * 0.001f64.powi(3));
+    let (a_j, gap_m) = (1.0e-19, 1.0e-6);
+    let hamaker =
+        format!("{{ hamaker: {{ constant_j: {a_j}, inner_cutoff_m: 4.0e-10, outer_cutoff_m: 5.0e-6, walls: true }} }}");
+    let b = built(&sphere_over_a_bead(&hamaker, 2.0 * r + gap_m, 0.0, 1.0));
+    let mut sim = simulation(&b, 1);
+    sim.run_steps(1).expect("runs");
+    let dv = -sim.snapshot().particles.velocity_m_per_s[0].z;
+    let expected = a_j * (r / 2.0) / (6.0 * gap_m * gap_m) * b.dt_s / mass_kg;
+    println!("Hamaker: one step's Δv {dv:.6e} m/s, the pair's A R*/(6 D²) gives {expected:.6e}");
+    assert!(
+        (dv / expected - 1.0).abs() < 1e-6,
+        "Δv {dv} against the pair's {expected}"
+    );
+
+    // Square well: ε = 5e-10 J, r_out/r_in = 1.01: the well's edge at a centre distance of 2.02 mm. The sphere starts
+    // at 2.03 mm at 0.01 m/s and ends inside the well (at about 2.013 mm, before contact at 2.0 mm).
+    let (depth_j, v0) = (5.0e-10, 0.01);
+    let well = format!("{{ square_well: {{ depth_j: {depth_j}, outer_to_inner_radius_ratio: 1.01, walls: true }} }}");
+    let b = built(&sphere_over_a_bead(&well, 2.03e-3, v0, 1.5e-3));
+    let mut sim = simulation(&b, 1);
+    sim.run_steps((1.5e-3 / b.dt_s).round() as u64).expect("runs");
+    let s = sim.snapshot();
+    let (z, v) = (s.particles.position_m[0].z, -s.particles.velocity_m_per_s[0].z);
+    let pair = (v0 * v0 + 2.0 * depth_j / mass_kg).sqrt();
+    let flat = (v0 * v0 + 4.0 * depth_j / mass_kg).sqrt();
+    println!("square well: at {z:.6e} m, {v:.6e} m/s; the pair's well gives {pair:.6e}, a flat wall's {flat:.6e}");
+    assert!(
+        z < 2.02e-3 && z > 2.0e-3,
+        "ends at {z} m, expected inside the well and out of contact"
+    );
+    assert!((v / pair - 1.0).abs() < 1e-9, "speed {v} m/s, the pair's well {pair}");
+}
+
 /// A heated drum's beads are found as its own (`Wall::glued_to`), for the contact arc that E5's h_w divides by: the
 /// bead radius on a beaded drum, 0 on a smooth one; another drum's beads do not count.
 #[test]

@@ -546,6 +546,20 @@ impl Cohesion {
         constants
     }
 
+    /// Widens the particle–wall range for walls of glued beads up to `bead_radius_m` in radius (particles up to
+    /// `max_radius_m`): the square well to a bead is the pair's, reaching (ratio − 1)(R_i + r_b) beyond contact, and
+    /// is seen twice as far, as a flat wall's is, so that a particle just outside is still seen leaving. Hamaker's
+    /// range is a gap and liquid bridges to beads keep the flat form: neither changes.
+    pub fn reach_glued_beads(&mut self, bead_radius_m: f64, max_radius_m: f64) {
+        if let CohesionModel::SquareWell(w) = self.model
+            && self.wall_range_m > 0.0
+            && bead_radius_m > 0.0
+        {
+            let reach_m = 2.0 * (w.outer_to_inner_radius_ratio - 1.0) * (max_radius_m + bead_radius_m);
+            self.wall_range_m = self.wall_range_m.max(reach_m);
+        }
+    }
+
     /// The liquid particles i and j (films `liquid_*_m3`, radii `radius_*_m`) give a bridge forming between them,
     /// (from i, from j), m³: their caps (eqs 6.1–6.4) or half a fixed volume each ([`BridgeVolume`]).
     pub fn pair_bridge_take_m3(

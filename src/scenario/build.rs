@@ -303,6 +303,10 @@ pub fn build(spec: ScenarioSpec, path: &Path) -> Result<BuiltScenario, ConfigErr
                 .map_err(|(key, message)| c.fail(key, message))?,
         ),
     };
+    if let Some(cohesion) = cohesion.as_mut() {
+        let bead_radius_m = walls.iter().filter_map(Wall::bead_radius_m).fold(0.0, f64::max);
+        cohesion.reach_glued_beads(bead_radius_m, particles.max_radius_m());
+    }
     if let Some(off) = &spec.cohesion_off {
         let Some(cohesion) = cohesion.as_mut() else {
             return Err(c.fail("cohesion_off", "expected a `cohesion` model to switch off"));

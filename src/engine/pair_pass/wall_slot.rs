@@ -9,6 +9,7 @@ use super::super::channels::ScalarFlows;
 use super::super::cohesion::{Bond, BridgeConstants};
 use super::super::contacts::ColumnsMut;
 use super::super::models::ContactKinematics;
+use super::super::models::cohesion_law::CohesionModel;
 use super::{Context, PassKind, WorstOverlap, cohesion_state};
 
 /// Result of one wall slot: the contact's (force, torque) on i while it overlaps, the cohesion model's while it acts,
@@ -150,7 +151,9 @@ impl Context<'_> {
     /// One wall slot of particle i (local slot `k`, slot `slot` of the whole list): the contact law's force and
     /// torque on i while it overlaps the wall (otherwise the contact history is released), and the cohesion model's
     /// while it acts, the wall a partner of infinite radius and mass (R* = R_i, μ = m_i, a square well twice as
-    /// deep: seed 001 §6.2.4.2; the contact law takes a glued bead's R* of the pair, the cohesion models keep R_i). Third: the flows of a contact that ended here (where the run records channels).
+    /// deep: seed 001 §6.2.4.2). A glued bead is a glued particle (μ = m_i): the contact law, Hamaker's force and
+    /// the square well take the pair's R*, centre distance and depth; a liquid bridge to it keeps the sphere–plane
+    /// form of its tables. Third: the flows of a contact that ended here (where the run records channels).
     #[allow(clippy::too_many_arguments)]
     #[inline(always)]
     pub(super) fn wall_slot<P: PassKind>(
@@ -230,16 +233,24 @@ impl Context<'_> {
             return (contact, None, flows);
         }
         let n = prox.normal;
+        // A bead as the pair's partner sphere (radius r_b), or the wall as an infinite one.
+        let (centre_distance_m, partner_radius_m, effective_radius_m, depth_factor) = match wall
+            .bead_radius_m()
+            .filter(|_| !matches!(c.model, CohesionModel::LiquidBridge(_)))
+        {
+            Some(r_b) => (prox.gap_m + r_b, ri + r_b, ri * r_b / (ri + r_b), 1.0),
+            None => (prox.gap_m, ri, ri, 2.0),
+        };
         let bond = Bond {
             normal: n,
             gap_m: gap,
-            centre_distance_m: prox.gap_m,
-            well_distance_m: c.well_ratio * ri,
-            effective_radius_m: ri,
+            centre_distance_m,
+            well_distance_m: c.well_ratio * partner_radius_m,
+            effective_radius_m,
             effective_mass_kg: self.mass_kg[i],
             approach_m_per_s: -(vi - prox.wall_velocity).dot(&n),
             contact_velocity: vi - prox.wall_velocity - (wi * ri).cross(&n),
-            depth_factor: 2.0,
+            depth_factor,
             wall: true,
         };
         let bridge = self.bridges.wall.get(slot).unwrap_or(&BridgeConstants::NONE);
