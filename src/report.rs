@@ -1,7 +1,9 @@
 //! `granflow report <campaign-dir>`: the validation report of a validation campaign (one with a `validation:`
 //! section) as Markdown — our numbers next to the source's, the command that reproduces them, the choices the
-//! source leaves open, every job's parameters and metrics, and a last line `verdict: pass` or
-//! `verdict: fail (<which checks>)`.
+//! source leaves open, the wall time the jobs took (`wall_time`), every job's parameters and metrics, and a last
+//! line `verdict: pass` or `verdict: fail (<which checks>)`.
+
+mod wall_time;
 
 use std::collections::BTreeMap;
 use std::fmt::Write;
@@ -13,6 +15,7 @@ use crate::campaign::validation::{CheckSpec, CheckValue};
 use crate::campaign_dir::{database_path, load_stored_campaign, spec_copy_path};
 use crate::error::Error;
 use crate::store::Store;
+use wall_time::{Attempt, WallTime};
 
 fn store_err(e: crate::store::StoreError) -> Error {
     Error::External(e.to_string())
@@ -221,9 +224,26 @@ pub fn report(dir: &Path) -> Result<(String, bool), Error> {
         .collect();
     let (_, timing_rows) = store
         .query_sql(&format!(
-            "SELECT job_id, sim_time_s, wall_time_s FROM jobs WHERE campaign_id = {id} ORDER BY ordinal"
+            "SELECT job_id, sim_time_s FROM jobs WHERE campaign_id = {id} ORDER BY ordinal"
         ))
         .map_err(store_err)?;
+    let (_, attempt_rows) = store
+        .query_sql(&format!(
+            "SELECT a.job_id, a.started_at, a.ended_at FROM attempts a JOIN jobs j ON j.job_id = a.job_id
+             WHERE j.campaign_id = {id}"
+        ))
+        .map_err(store_err)?;
+    let attempts: Vec<Attempt> = attempt_rows
+        .iter()
+        .filter_map(|r| {
+            Some(Attempt {
+                job_id: r[0].as_str()?.to_string(),
+                started_s: r[1].as_f64()?,
+                ended_s: r[2].as_f64(),
+            })
+        })
+        .collect();
+    let wall_time = WallTime::of(&attempts);
     let counts = store.status_counts(id).map_err(store_err)?;
     // Which builds finished the done jobs (the attempt that ended `done`; NULL before builds were recorded).
     let (_, build_rows) = store
@@ -256,6 +276,7 @@ pub fn report(dir: &Path) -> Result<(String, bool), Error> {
         crate::provenance::build_id()
     );
     md.push_str(&builds_paragraph(&builds));
+    md.push_str(&wall_time.sentence());
     if !campaign.spec.description.trim().is_empty() {
         let _ = writeln!(md, "{}\n", campaign.spec.description.trim());
     }
@@ -308,22 +329,25 @@ pub fn report(dir: &Path) -> Result<(String, bool), Error> {
     let shown: Vec<usize> = (0..header.len()).filter(|&k| k != 0).collect();
     let _ = writeln!(
         md,
-        "| {} | wall s per simulated s |",
+        "| {} | wall s (all attempts) | wall s per simulated s |",
         shown
             .iter()
             .map(|&k| header[k].as_str())
             .collect::<Vec<_>>()
             .join(" | ")
     );
-    let _ = writeln!(md, "|{}---|", "---|".repeat(shown.len()));
+    let _ = writeln!(md, "|{}---|---|", "---|".repeat(shown.len()));
     for (row, timing) in rows.iter().zip(&timing_rows) {
-        let per_s = match (timing[1].as_f64(), timing[2].as_f64()) {
-            (Some(sim), Some(wall)) if sim > 0.0 => format!("{:.1}", wall / sim),
-            _ => String::new(),
+        // The job's attempts (a resumed job's result holds only its last attempt's wall time).
+        let wall = timing[0].as_str().and_then(|job| wall_time.per_job_s.get(job)).copied();
+        let (wall_s, per_s) = match (timing[1].as_f64(), wall) {
+            (Some(sim), Some(wall)) if sim > 0.0 => (format!("{wall:.0}"), format!("{:.1}", wall / sim)),
+            (_, Some(wall)) => (format!("{wall:.0}"), String::new()),
+            _ => (String::new(), String::new()),
         };
         let _ = writeln!(
             md,
-            "| {} | {per_s} |",
+            "| {} | {wall_s} | {per_s} |",
             shown.iter().map(|&k| cell(&row[k])).collect::<Vec<_>>().join(" | ")
         );
     }
