@@ -7,6 +7,7 @@ use std::path::{Path, PathBuf};
 use crate::campaign::{self, Campaign};
 use crate::campaign_dir::{database_path, load_stored_campaign, stored_campaign_id};
 use crate::error::Error;
+use crate::report::wall_time::WallTime;
 use crate::store::{self, JobStatus, Store};
 
 /// Output formats of `query` and `export`.
@@ -89,9 +90,12 @@ pub fn status(dir: &Path) -> Result<String, Error> {
             r.error.as_deref().unwrap_or("")
         );
     }
+    // A done job's wall time over all its attempts (its result holds only the last one's).
+    let attempts = WallTime::of(&store.attempt_spans(id).map_err(store_err)?).per_job_s;
     let walls: Vec<f64> = rows
         .iter()
-        .filter_map(|r| (r.status == JobStatus::Done).then_some(r.wall_time_s).flatten())
+        .filter(|r| r.status == JobStatus::Done)
+        .filter_map(|r| attempts.get(&r.job_id).copied().or(r.wall_time_s))
         .collect();
     // Each running job: its completed fraction, and, for a first attempt, the wall time it is on course for.
     let running_jobs: Vec<(f64, Option<f64>)> = rows

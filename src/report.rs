@@ -3,7 +3,7 @@
 //! source leaves open, the wall time the jobs took (`wall_time`), every job's parameters and metrics, and a last
 //! line `verdict: pass` or `verdict: fail (<which checks>)`.
 
-mod wall_time;
+pub(crate) mod wall_time;
 
 use std::collections::BTreeMap;
 use std::fmt::Write;
@@ -15,7 +15,7 @@ use crate::campaign::validation::{CheckSpec, CheckValue};
 use crate::campaign_dir::{database_path, load_stored_campaign, spec_copy_path};
 use crate::error::Error;
 use crate::store::Store;
-use wall_time::{Attempt, WallTime};
+use wall_time::WallTime;
 
 fn store_err(e: crate::store::StoreError) -> Error {
     Error::External(e.to_string())
@@ -227,23 +227,7 @@ pub fn report(dir: &Path) -> Result<(String, bool), Error> {
             "SELECT job_id, sim_time_s FROM jobs WHERE campaign_id = {id} ORDER BY ordinal"
         ))
         .map_err(store_err)?;
-    let (_, attempt_rows) = store
-        .query_sql(&format!(
-            "SELECT a.job_id, a.started_at, a.ended_at FROM attempts a JOIN jobs j ON j.job_id = a.job_id
-             WHERE j.campaign_id = {id}"
-        ))
-        .map_err(store_err)?;
-    let attempts: Vec<Attempt> = attempt_rows
-        .iter()
-        .filter_map(|r| {
-            Some(Attempt {
-                job_id: r[0].as_str()?.to_string(),
-                started_s: r[1].as_f64()?,
-                ended_s: r[2].as_f64(),
-            })
-        })
-        .collect();
-    let wall_time = WallTime::of(&attempts);
+    let wall_time = WallTime::of(&store.attempt_spans(id).map_err(store_err)?);
     let counts = store.status_counts(id).map_err(store_err)?;
     // Which builds finished the done jobs (the attempt that ended `done`; NULL before builds were recorded).
     let (_, build_rows) = store

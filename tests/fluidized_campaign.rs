@@ -111,8 +111,14 @@ fn a_fluidized_bed_campaign_stores_gas_metrics_derives_u_mf_and_reports() {
     );
     assert_eq!(sql("SELECT DISTINCT build FROM attempts"), format!("build\n{build}\n"));
     // The wall time the jobs took, from their attempts, and per job.
-    assert!(report.contains("Wall time: ") && report.contains(" of worker time in all"), "{report}");
-    assert!(report.contains("| wall s (all attempts) | wall s per simulated s |"), "{report}");
+    assert!(
+        report.contains("Wall time: ") && report.contains(" of worker time in all"),
+        "{report}"
+    );
+    assert!(
+        report.contains("| wall s (all attempts) | wall s per simulated s |"),
+        "{report}"
+    );
     let result_dir = std::fs::read_dir(dir.join("bed/jobs"))
         .unwrap()
         .next()

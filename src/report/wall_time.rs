@@ -5,17 +5,11 @@
 
 use std::collections::HashMap;
 
-/// One attempt of a job: its start and end, unix s (`None` while running or when its end was not observed).
-#[derive(Debug, Clone, PartialEq)]
-pub(super) struct Attempt {
-    pub job_id: String,
-    pub started_s: f64,
-    pub ended_s: Option<f64>,
-}
+use crate::store::AttemptSpan;
 
 /// The wall time of a campaign's ended attempts.
 #[derive(Debug, Clone, PartialEq)]
-pub(super) struct WallTime {
+pub(crate) struct WallTime {
     /// Per job: the sum of its ended attempts' durations, s.
     pub per_job_s: HashMap<String, f64>,
     /// The union of the attempts' spans: the time at least one job ran, s.
@@ -25,7 +19,8 @@ pub(super) struct WallTime {
 }
 
 impl WallTime {
-    pub fn of(attempts: &[Attempt]) -> WallTime {
+    /// From the attempts that ended (a running one counts when it ends).
+    pub fn of(attempts: &[AttemptSpan]) -> WallTime {
         let spans: Vec<(&str, f64, f64)> = attempts
             .iter()
             .filter_map(|a| {
@@ -90,8 +85,8 @@ fn union_length_s(mut spans: Vec<(f64, f64)>) -> f64 {
 mod tests {
     use super::*;
 
-    fn attempt(job: &str, started_s: f64, ended_s: Option<f64>) -> Attempt {
-        Attempt {
+    fn attempt(job: &str, started_s: f64, ended_s: Option<f64>) -> AttemptSpan {
+        AttemptSpan {
             job_id: job.into(),
             started_s,
             ended_s,

@@ -162,6 +162,15 @@ pub enum AfterFailure {
     Final,
 }
 
+/// One attempt of a job: when it started and ended, unix s (`ended_s` is `None` while it runs, or when the
+/// dispatcher stopped before seeing its end).
+#[derive(Debug, Clone, PartialEq)]
+pub struct AttemptSpan {
+    pub job_id: String,
+    pub started_s: f64,
+    pub ended_s: Option<f64>,
+}
+
 /// One job as stored, for status displays and reconciliation.
 #[derive(Debug, Clone, PartialEq)]
 pub struct JobRow {

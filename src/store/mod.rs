@@ -34,7 +34,7 @@ pub use campaign::Campaign;
 use error::Context;
 pub use error::StoreError;
 pub use failure_class::FailureClass;
-pub use job::{AfterFailure, JobResult, JobRow, JobStatus, Metric, NewJob, ParamValue};
+pub use job::{AfterFailure, AttemptSpan, JobResult, JobRow, JobStatus, Metric, NewJob, ParamValue};
 pub use migrations::SCHEMA_VERSION;
 pub use pivot::{Pivot, PivotCell};
 pub use render::{render_csv, render_json, render_table};

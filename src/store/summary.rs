@@ -11,7 +11,7 @@ use serde_json::Value;
 use super::Store;
 use super::error::{Context, StoreError};
 use super::failure_class::FailureClass;
-use super::job::{JobRow, JobStatus, ParamValue};
+use super::job::{AttemptSpan, JobRow, JobStatus, ParamValue};
 use super::render::json_real;
 
 impl Store {
@@ -91,6 +91,28 @@ impl Store {
                 (row.get::<_, String>(0)?, row.get::<_, FailureClass>(1)?),
                 row.get::<_, i64>(2)?.max(0) as u32,
             ))
+        })
+        .and_then(|rows| rows.collect())
+        .context(&self.path, action)
+    }
+
+    /// Every attempt of the campaign's jobs, with its start and end (a resumed job has one per run of the
+    /// dispatcher; its result records only the last one's wall time).
+    pub fn attempt_spans(&self, campaign_id: i64) -> Result<Vec<AttemptSpan>, StoreError> {
+        let action = format_args!("listing the attempts of campaign {campaign_id}");
+        let mut stmt = self
+            .conn
+            .prepare_cached(
+                "SELECT a.job_id, a.started_at, a.ended_at FROM attempts a JOIN jobs j ON j.job_id = a.job_id
+                 WHERE j.campaign_id = ?1 ORDER BY a.id",
+            )
+            .context(&self.path, action)?;
+        stmt.query_map([campaign_id], |row| {
+            Ok(AttemptSpan {
+                job_id: row.get(0)?,
+                started_s: row.get(1)?,
+                ended_s: row.get(2)?,
+            })
         })
         .and_then(|rows| rows.collect())
         .context(&self.path, action)
