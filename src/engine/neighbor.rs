@@ -166,9 +166,12 @@ impl Criteria<'_> {
         } else {
             ri + self.range.wall_gap_m + self.skin_m
         };
-        wall.proximity_turned(&self.position[i], self.wall_turn[w as usize])
-            .gap_m
-            < reach
+        // The bound first: the bed's interior is far from a drum's beads and baffles (the same decisions).
+        wall.gap_lower_bound_m(&self.position[i]) < reach
+            && wall
+                .proximity_turned(&self.position[i], self.wall_turn[w as usize])
+                .gap_m
+                < reach
     }
 }
 

@@ -241,6 +241,45 @@ impl Wall {
         }
     }
 
+    /// A lower bound of [`Wall::proximity`]'s gap at `x` whatever the wall's turn, from the distance to the axis
+    /// alone: a glued bead's centre lies on the cylinder of radius `radius_m`, and every point of a baffle's
+    /// mid-section between its nearest and farthest distances from the axis, so a particle at distance ρ from the
+    /// axis is at least |ρ − radius| (beads) or max(0, nearest − ρ, ρ − farthest) (baffles) from them. Less a
+    /// rounding allowance of 1e-9 of the lengths involved, so that it never exceeds the gap `proximity` computes.
+    /// The neighbour build uses it to skip the exact gap (an `atan2` per bead wall) for the bed's interior, which
+    /// changes no decision. Shapes whose exact gap is as cheap give −∞.
+    #[inline]
+    pub fn gap_lower_bound_m(&self, x: &Vec3) -> f64 {
+        let axis_distance_m = |frame: &RotatingFrame| {
+            let r = x - frame.axis_point_m;
+            (r - frame.axis * r.dot(&frame.axis)).norm()
+        };
+        match &self.shape {
+            WallShape::Plane { .. } | WallShape::RotatingCylinder { .. } | WallShape::PlaneBeads { .. } => {
+                f64::NEG_INFINITY
+            }
+            WallShape::GluedBeads {
+                frame,
+                radius_m,
+                bead_radius_m,
+                ..
+            } => {
+                let rho = axis_distance_m(frame);
+                (rho - radius_m).abs() - bead_radius_m - 1e-9 * (rho + radius_m)
+            }
+            WallShape::Baffle {
+                frame,
+                start_m,
+                end_m,
+                half_thickness_m,
+            } => {
+                let rho = axis_distance_m(frame);
+                let (nearest_m, farthest_m) = segment_axis_distances_m(start_m, end_m);
+                (nearest_m - rho).max(rho - farthest_m).max(0.0) - half_thickness_m - 1e-9 * (rho + farthest_m)
+            }
+        }
+    }
+
     /// Gap, normal and wall velocity for a particle centre at `x` when the wall has turned by `angle_rad`.
     #[inline]
     pub fn proximity(&self, x: &Vec3, angle_rad: f64) -> WallProximity {
@@ -360,6 +399,20 @@ impl Wall {
     }
 }
 
+/// The nearest and farthest distances from the origin of the segment `start`–`end` (in-plane coordinates, m).
+fn segment_axis_distances_m(start_m: &[f64; 2], end_m: &[f64; 2]) -> (f64, f64) {
+    let (su, sv) = (end_m[0] - start_m[0], end_m[1] - start_m[1]);
+    let len2 = su * su + sv * sv;
+    let t = if len2 > 0.0 {
+        (-(start_m[0] * su + start_m[1] * sv) / len2).clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
+    let nearest = (start_m[0] + t * su).hypot(start_m[1] + t * sv);
+    let farthest = start_m[0].hypot(start_m[1]).max(end_m[0].hypot(end_m[1]));
+    (nearest, farthest)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -450,6 +503,87 @@ mod tests {
                 }
             }
         }
+    }
+
+    /// The neighbour build's bound never exceeds the exact gap, at any turn, for glued beads and for baffles along
+    /// a radius, leaning, and through the axis; and it is the gap itself (within its allowance) straight in front
+    /// of a bead, on the baffle's own radius beyond its tip, and far inside a drum's beads.
+    #[test]
+    fn the_gap_bound_is_below_every_gap_and_tight_where_it_should_be() {
+        let frame = RotatingFrame::new(Vec3::new(0.01, -0.02, 0.0), Vec3::z(), 0.7);
+        let beads = Wall::new(
+            "beads".into(),
+            SpeciesId(0),
+            WallShape::GluedBeads {
+                frame,
+                radius_m: 0.1,
+                bead_radius_m: 0.0015,
+                count_around: 210,
+                axial_spacing_m: 0.00315,
+                parity: [1, 0],
+            },
+        );
+        let baffle = |start_m: [f64; 2], end_m: [f64; 2]| {
+            Wall::new(
+                "baffle".into(),
+                SpeciesId(0),
+                WallShape::Baffle {
+                    frame,
+                    start_m,
+                    end_m,
+                    half_thickness_m: 0.0015,
+                },
+            )
+        };
+        let walls = [
+            beads.clone(),
+            baffle([0.1, 0.0], [0.08, 0.0]),
+            baffle([0.0, 0.1], [0.014, 0.086]),
+            baffle([-0.05, 0.0], [0.05, 0.0]),
+            baffle([0.0, 0.0], [0.0, 0.05]),
+        ];
+        for wall in &walls {
+            for angle_rad in [0.0, 0.4, -2.5, std::f64::consts::PI] {
+                for i in 0..60 {
+                    for j in 0..60 {
+                        let x = frame.axis_point_m
+                            + Vec3::new(
+                                -0.11 + 0.22 * f64::from(i) / 59.0,
+                                -0.11 + 0.22 * f64::from(j) / 59.0,
+                                0.002,
+                            );
+                        let gap = wall.proximity(&x, angle_rad).gap_m;
+                        let bound = wall.gap_lower_bound_m(&x);
+                        assert!(
+                            bound <= gap,
+                            "{} at {x:?}, turn {angle_rad}: bound {bound} > gap {gap}",
+                            wall.name
+                        );
+                    }
+                }
+            }
+        }
+        let along = |angle_rad: f64, rho: f64| {
+            frame.axis_point_m + Vec3::new(rho * angle_rad.cos(), rho * angle_rad.sin(), 0.0)
+        };
+        // Bead k = 1 at turn 0 (parity 1), axial ring 0: straight in front of it, 2 mm inside.
+        let x = along(2.0 * std::f64::consts::PI / 210.0, 0.098);
+        let (gap, bound) = (beads.proximity(&x, 0.0).gap_m, beads.gap_lower_bound_m(&x));
+        assert!(
+            gap - bound < 1e-9 && (gap - 0.0005).abs() < 1e-12,
+            "gap {gap} bound {bound}"
+        );
+        assert!((beads.gap_lower_bound_m(&along(1.0, 0.05)) - 0.0485).abs() < 1e-9);
+        // The plate from 0.1 to 0.08 along e1, and a point 1 cm further in on its radius: 1 cm − half thickness.
+        let x = along(0.0, 0.07);
+        let (gap, bound) = (walls[1].proximity(&x, 0.0).gap_m, walls[1].gap_lower_bound_m(&x));
+        assert!(
+            (gap - 0.0085).abs() < 1e-12 && gap - bound < 1e-9,
+            "gap {gap} bound {bound}"
+        );
+        // Through the axis: no bound inside its reach; beyond it, the distance past its tip.
+        assert!(walls[3].gap_lower_bound_m(&along(1.0, 0.03)) < 0.0);
+        assert!((walls[3].gap_lower_bound_m(&along(1.0, 0.07)) - 0.0185).abs() < 1e-9);
     }
 
     /// The four sub-lattices together are the whole bead lattice: the nearest of their beads is the nearest bead,
