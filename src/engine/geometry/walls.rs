@@ -128,6 +128,9 @@ pub struct Wall {
     /// (k from −count/2 − 1 to count/2 + 1), computed once as [`Wall::proximity_turned`] would compute them per call
     /// (the same bits); empty for other shapes.
     bead_direction: Vec<(f64, f64)>,
+    /// A baffle's mid-section's nearest and farthest distances from the axis (`segment_axis_distances_m`), m,
+    /// computed once for [`Wall::gap_lower_bound_m`]; (0, 0) for other shapes.
+    baffle_axis_distances_m: (f64, f64),
 }
 
 /// The offset of k = 0 in [`Wall`]'s bead direction table, beyond the count/2 that k can reach.
@@ -157,12 +160,17 @@ impl Wall {
             }
             _ => Vec::new(),
         };
+        let baffle_axis_distances_m = match &shape {
+            WallShape::Baffle { start_m, end_m, .. } => segment_axis_distances_m(start_m, end_m),
+            _ => (0.0, 0.0),
+        };
         Wall {
             name,
             species,
             shape,
             glued_to: None,
             bead_direction,
+            baffle_axis_distances_m,
         }
     }
 
@@ -269,12 +277,11 @@ impl Wall {
             }
             WallShape::Baffle {
                 frame,
-                start_m,
-                end_m,
                 half_thickness_m,
+                ..
             } => {
                 let rho = axis_distance_m(frame);
-                let (nearest_m, farthest_m) = segment_axis_distances_m(start_m, end_m);
+                let (nearest_m, farthest_m) = self.baffle_axis_distances_m;
                 (nearest_m - rho).max(rho - farthest_m).max(0.0) - half_thickness_m - 1e-9 * (rho + farthest_m)
             }
         }
