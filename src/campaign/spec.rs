@@ -3,6 +3,7 @@
 
 use serde::{Deserialize, Serialize};
 
+use crate::analysis::mixing::Concentration;
 use crate::scenario::ScenarioSpec;
 
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize, schemars::JsonSchema)]
@@ -126,6 +127,11 @@ pub struct AnalysisSpec {
     /// Mixing state sampled every this many steps (a multiple of the series cadence).
     #[serde(default)]
     pub mixing_every_steps: Option<u64>,
+    /// How a sample's concentration of the mixing species is counted: `number` (default; the seed's count of
+    /// particles, right for unequal sizes too) or `volume` (volume fractions, each sample weighted by its
+    /// particle's volume). The same for equal sizes. See `analysis::mixing::mixing_state`.
+    #[serde(default, skip_serializing_if = "is_number_concentration")]
+    pub mixing_concentration: Concentration,
     /// Time averages (pressure drop, mean height) start here, s; default: half the end time.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub average_from_s: Option<f64>,
@@ -180,6 +186,10 @@ impl CyclePressure {
     }
 }
 
+fn is_number_concentration(c: &Concentration) -> bool {
+    *c == Concentration::Number
+}
+
 fn default_neighbours() -> usize {
     10
 }
@@ -190,6 +200,7 @@ impl Default for AnalysisSpec {
             mixing_species: None,
             mixing_neighbours: default_neighbours(),
             mixing_every_steps: None,
+            mixing_concentration: Concentration::Number,
             average_from_s: None,
             capillary_number_porosity: None,
             mixing_fit_from_s: None,

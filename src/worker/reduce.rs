@@ -47,6 +47,7 @@ pub const MIXING_COLUMNS: &str = ",intensity_of_segregation,lacey_index";
 pub struct MixingSampler {
     species_a: SpeciesId,
     neighbours: usize,
+    concentration: analysis::mixing::Concentration,
     every_steps: Option<u64>,
 }
 
@@ -56,6 +57,7 @@ impl MixingSampler {
         Some(MixingSampler {
             species_a: built.config.species.find(name)?,
             neighbours: job.analysis.mixing_neighbours,
+            concentration: job.analysis.mixing_concentration,
             every_steps: job.analysis.mixing_every_steps,
         })
     }
@@ -68,7 +70,7 @@ impl MixingSampler {
             .map(|r| 4.0 / 3.0 * std::f64::consts::PI * r * r * r)
             .collect();
         let is_a: Vec<bool> = p.species.iter().map(|&s| s == self.species_a).collect();
-        analysis::mixing::mixing_state(&p.position_m, &volumes, &is_a, self.neighbours)
+        analysis::mixing::mixing_state(&p.position_m, &volumes, &is_a, self.neighbours, self.concentration)
     }
 
     /// The extra series columns for the current state (`nan` between mixing samples).
@@ -487,8 +489,9 @@ fn inlet_velocity_m_per_s(sim: &Simulation) -> Option<f64> {
     sim.gas.as_ref()?.superficial_inflow_m_per_s()
 }
 
-/// IS of a random mixture, √(P(1−P)/n): P the volume fraction of the mixing species, n the particles of one local
-/// sample (the particle and its `mixing_neighbours` nearest neighbours).
+/// IS of a random mixture, √(P(1−P)/n): P the fraction of the mixing species (by number or volume, as
+/// `analysis.mixing_concentration`), n the particles of one local sample (the particle and its `mixing_neighbours`
+/// nearest neighbours). By volume with unequal sizes this is the equal-size value at the same P.
 fn random_mixture_intensity(job: &JobSpec, sim: &Simulation) -> f64 {
     let p = &sim.particles;
     let Some(a) = job
@@ -499,8 +502,12 @@ fn random_mixture_intensity(job: &JobSpec, sim: &Simulation) -> f64 {
     else {
         return f64::NAN;
     };
+    let by_number = job.analysis.mixing_concentration == analysis::mixing::Concentration::Number;
     let volume = |keep: &dyn Fn(usize) -> bool| -> f64 {
-        (0..p.len()).filter(|&i| keep(i)).map(|i| p.radius_m[i].powi(3)).sum()
+        (0..p.len())
+            .filter(|&i| keep(i))
+            .map(|i| if by_number { 1.0 } else { p.radius_m[i].powi(3) })
+            .sum()
     };
     let fraction = volume(&|i| p.species[i] == a) / volume(&|_| true);
     (fraction * (1.0 - fraction) / (job.analysis.mixing_neighbours + 1) as f64).sqrt()
