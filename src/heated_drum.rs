@@ -32,7 +32,7 @@ pub struct HeatedDrum {
 pub fn heated_drum(config: &SimConfig) -> Option<HeatedDrum> {
     let heat = config.heat.as_ref()?;
     let mut drums = config.walls.iter().enumerate().filter_map(|(w, wall)| {
-        let WallShape::RotatingCylinder { frame, radius_m } = &wall.shape else {
+        let WallShape::RotatingCylinder { frame, radius_m } = wall.shape() else {
             return None;
         };
         let temperature_k = heat.wall_temperature_k[w]?;

@@ -457,7 +457,7 @@ fn block_outside_drum(
 ) -> Result<(), ConfigError> {
     let key = "gas.outside_drum";
     let drum = fill::drum_named(c, key, walls, name)?;
-    let WallShape::RotatingCylinder { frame, radius_m } = &drum.shape else {
+    let WallShape::RotatingCylinder { frame, radius_m } = drum.shape() else {
         return Err(c.fail(key, format!("wall '{name}' is not a drum")));
     };
     let grid = &gas.config.grid;

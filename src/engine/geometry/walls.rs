@@ -120,7 +120,8 @@ fn nearest_with_parity(t: f64, parity: u8) -> f64 {
 pub struct Wall {
     pub name: String,
     pub species: SpeciesId,
-    pub shape: WallShape,
+    /// Private: `bead_direction` and `baffle_axis_distances_m` are derived from it when the wall is built.
+    shape: WallShape,
     /// The name of the wall whose glued beads this wall is (`None` for a wall of its own): a name given for a
     /// drum or plane in the scenario stands for its beads too (heat, cohesion switches, the heated drum's arc).
     pub glued_to: Option<String>,
@@ -172,6 +173,11 @@ impl Wall {
             bead_direction,
             baffle_axis_distances_m,
         }
+    }
+
+    /// The wall's geometry and motion, as built.
+    pub fn shape(&self) -> &WallShape {
+        &self.shape
     }
 
     /// This wall as glued beads of the wall called `parent`.
@@ -231,16 +237,8 @@ impl Wall {
         match &self.shape {
             // A cylinder's surface moves only tangentially to itself: its gap to any point never changes.
             WallShape::Plane { .. } | WallShape::RotatingCylinder { .. } | WallShape::PlaneBeads { .. } => 0.0,
-            WallShape::Baffle {
-                start_m,
-                end_m,
-                half_thickness_m,
-                ..
-            } => {
-                let r0 = (start_m[0].powi(2) + start_m[1].powi(2)).sqrt();
-                let r1 = (end_m[0].powi(2) + end_m[1].powi(2)).sqrt();
-                r0.max(r1) + half_thickness_m
-            }
+            // The farthest point of the mid-section (an end) plus half the plate's thickness.
+            WallShape::Baffle { half_thickness_m, .. } => self.baffle_axis_distances_m.1 + half_thickness_m,
             WallShape::GluedBeads {
                 radius_m,
                 bead_radius_m,

@@ -22,7 +22,7 @@ fn fits(x: &Vec3, r: f64, walls: &[Wall], domain: &Domain) -> bool {
 pub(super) fn drum_named<'a>(c: &Checker, key: &str, walls: &'a [Wall], name: &str) -> Result<&'a Wall, ConfigError> {
     walls
         .iter()
-        .find(|w| w.name == name && matches!(w.shape, WallShape::RotatingCylinder { .. }))
+        .find(|w| w.name == name && matches!(w.shape(), WallShape::RotatingCylinder { .. }))
         .ok_or_else(|| c.fail(key, format!("no drum named '{name}'")))
 }
 
