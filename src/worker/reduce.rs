@@ -246,7 +246,9 @@ pub fn metrics(job: &JobSpec, built: &BuiltScenario, sim: &Simulation, series: &
                     .and_then(|(t, is, _)| analysis::fit::fit_exponential_decay(&t, &is))
                     .map_or(f64::NAN, |f| f.rate_constant_per_s),
                 JobMetric::MixingRateToRandom => {
-                    let random = random_mixture_intensity(job, sim);
+                    let random = mixing_final.as_ref().map_or(f64::NAN, |m| {
+                        random_mixture_intensity(m.fraction_a, job.analysis.mixing_neighbours)
+                    });
                     mixing_series()
                         .and_then(|(t, is, _)| analysis::fit::fit_exponential_decay_to(&t, &is, random))
                         .map_or(f64::NAN, |f| f.rate_constant_per_s)
@@ -490,27 +492,11 @@ fn inlet_velocity_m_per_s(sim: &Simulation) -> Option<f64> {
 }
 
 /// IS of a random mixture, √(P(1−P)/n): P the fraction of the mixing species (by number or volume, as
-/// `analysis.mixing_concentration`), n the particles of one local sample (the particle and its `mixing_neighbours`
-/// nearest neighbours). By volume with unequal sizes this is the equal-size value at the same P.
-fn random_mixture_intensity(job: &JobSpec, sim: &Simulation) -> f64 {
-    let p = &sim.particles;
-    let Some(a) = job
-        .analysis
-        .mixing_species
-        .as_ref()
-        .and_then(|name| sim.config.species.find(name))
-    else {
-        return f64::NAN;
-    };
-    let by_number = job.analysis.mixing_concentration == analysis::mixing::Concentration::Number;
-    let volume = |keep: &dyn Fn(usize) -> bool| -> f64 {
-        (0..p.len())
-            .filter(|&i| keep(i))
-            .map(|i| if by_number { 1.0 } else { p.radius_m[i].powi(3) })
-            .sum()
-    };
-    let fraction = volume(&|i| p.species[i] == a) / volume(&|_| true);
-    (fraction * (1.0 - fraction) / (job.analysis.mixing_neighbours + 1) as f64).sqrt()
+/// `analysis.mixing_concentration`; the final state's `fraction_a`), n the particles of one local sample (the
+/// particle and its `mixing_neighbours` nearest neighbours). By volume with unequal sizes this is the equal-size
+/// value at the same P.
+fn random_mixture_intensity(fraction_a: f64, neighbours: usize) -> f64 {
+    (fraction_a * (1.0 - fraction_a) / (neighbours + 1) as f64).sqrt()
 }
 
 /// One level of `gas.inflow_levels`: its velocity and the pressure drop's mean and standard deviation over the
