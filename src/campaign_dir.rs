@@ -17,7 +17,7 @@ use std::path::{Path, PathBuf};
 
 use crate::campaign::{self, Campaign};
 use crate::error::Error;
-use crate::store::{self, Store};
+use crate::store::Store;
 
 /// The results database of a campaign directory.
 pub fn database_path(dir: &Path) -> PathBuf {
@@ -74,10 +74,6 @@ pub fn worker_lock_path(job_dir: &Path) -> PathBuf {
     job_dir.join("worker.lock")
 }
 
-fn store_err(e: store::StoreError) -> Error {
-    Error::External(e.to_string())
-}
-
 /// The campaign stored in a campaign directory (its copy of the campaign file).
 pub fn load_stored_campaign(dir: &Path) -> Result<Campaign, Error> {
     let path = spec_copy_path(dir);
@@ -94,8 +90,7 @@ pub fn load_stored_campaign(dir: &Path) -> Result<Campaign, Error> {
 /// The database id of the campaign stored in `dir`.
 pub fn stored_campaign_id(store: &Store, campaign: &Campaign, dir: &Path) -> Result<i64, Error> {
     Ok(store
-        .campaign_by_name(&campaign.spec.name)
-        .map_err(store_err)?
+        .campaign_by_name(&campaign.spec.name)?
         .ok_or_else(|| {
             Error::External(format!(
                 "{}: no campaign `{}` in the database",

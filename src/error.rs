@@ -9,6 +9,7 @@ use std::path::PathBuf;
 use crate::checkpoint::CheckpointError;
 use crate::engine::NumericalError;
 use crate::scenario::ConfigError;
+use crate::store::StoreError;
 
 /// Exit code for invalid input (configuration, YAML, CLI arguments), checked before anything is written.
 pub const EXIT_CONFIG: i32 = 2;
@@ -16,7 +17,8 @@ pub const EXIT_CONFIG: i32 = 2;
 pub const EXIT_NUMERICAL: i32 = 3;
 /// Exit code for an unreadable, corrupt or unwritable checkpoint.
 pub const EXIT_CHECKPOINT: i32 = 4;
-/// Exit code for other I/O failures and failures of external programs (e.g. LIGGGHTS in `bench`).
+/// Exit code for other I/O failures (the campaign store's among them) and failures of external programs (e.g.
+/// LIGGGHTS in `bench`).
 pub const EXIT_IO: i32 = 5;
 
 #[derive(Debug, thiserror::Error)]
@@ -27,6 +29,9 @@ pub enum Error {
     Numerical(#[from] NumericalError),
     #[error(transparent)]
     Checkpoint(#[from] CheckpointError),
+    /// The campaign store (SQLite) could not be opened, read or written.
+    #[error(transparent)]
+    Store(#[from] StoreError),
     #[error("{action} {path}: {source}")]
     Io {
         action: &'static str,
@@ -48,7 +53,7 @@ impl Error {
             Error::Config(_) | Error::Usage(_) => EXIT_CONFIG,
             Error::Numerical(_) => EXIT_NUMERICAL,
             Error::Checkpoint(_) => EXIT_CHECKPOINT,
-            Error::Io { .. } | Error::External(_) => EXIT_IO,
+            Error::Io { .. } | Error::Store(_) | Error::External(_) => EXIT_IO,
         }
     }
 
@@ -72,3 +77,23 @@ impl From<crate::util::AtomicWriteError> for Error {
 }
 
 pub type Result<T, E = Error> = std::result::Result<T, E>;
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A store that cannot be opened is an I/O failure (exit 5), and its message still names the database file.
+    #[test]
+    fn a_store_error_exits_as_io_and_names_the_database() {
+        let path = std::env::temp_dir()
+            .join("granflow-no-such-dir")
+            .join("campaign.sqlite");
+        let e: Error = crate::store::Store::open_read_only(&path)
+            .map(|_| ())
+            .unwrap_err()
+            .into();
+        assert!(matches!(e, Error::Store(_)));
+        assert_eq!(e.exit_code(), EXIT_IO);
+        assert!(e.to_string().contains(&path.display().to_string()), "{e}");
+    }
+}

@@ -18,13 +18,9 @@ pub enum Format {
     Json,
 }
 
-fn store_err(e: store::StoreError) -> Error {
-    Error::External(e.to_string())
-}
-
 fn open(dir: &Path) -> Result<(Store, i64, Campaign), Error> {
     let campaign = load_stored_campaign(dir)?;
-    let store = Store::open_read_only(database_path(dir)).map_err(store_err)?;
+    let store = Store::open_read_only(database_path(dir))?;
     let id = stored_campaign_id(&store, &campaign, dir)?;
     Ok((store, id, campaign))
 }
@@ -32,7 +28,7 @@ fn open(dir: &Path) -> Result<(Store, i64, Campaign), Error> {
 /// `granflow status`: jobs by state, running jobs' progress, failures with reasons, an ETA.
 pub fn status(dir: &Path) -> Result<String, Error> {
     let (store, id, campaign) = open(dir)?;
-    let rows = store.job_summaries(id).map_err(store_err)?;
+    let rows = store.job_summaries(id)?;
     let count = |s: JobStatus| rows.iter().filter(|r| r.status == s).count();
     let (pending, running, done, failed) = (
         count(JobStatus::Pending),
@@ -91,7 +87,7 @@ pub fn status(dir: &Path) -> Result<String, Error> {
         );
     }
     // A done job's wall time over all its attempts (its result holds only the last one's).
-    let attempts = WallTime::of(&store.attempt_spans(id).map_err(store_err)?).per_job_s;
+    let attempts = WallTime::of(&store.attempt_spans(id)?).per_job_s;
     let walls: Vec<f64> = rows
         .iter()
         .filter(|r| r.status == JobStatus::Done)
@@ -165,9 +161,7 @@ fn status_eta(
 
 /// Resolves a user's parameter name to a stored parameter path: the exact path, or the unique path ending in it.
 fn resolve_param(store: &Store, name: &str) -> Result<String, Error> {
-    let (_, rows) = store
-        .query_sql("SELECT DISTINCT name FROM params ORDER BY name")
-        .map_err(store_err)?;
+    let (_, rows) = store.query_sql("SELECT DISTINCT name FROM params ORDER BY name")?;
     let names: Vec<String> = rows.iter().filter_map(|r| r[0].as_str().map(str::to_string)).collect();
     if names.iter().any(|n| n == name) {
         return Ok(name.to_string());
@@ -232,7 +226,7 @@ pub(crate) fn layout_of(
         store::StoreError::UnknownParameter { .. }
         | store::StoreError::UnknownMetric { .. }
         | store::StoreError::InvalidQuery { .. } => Error::Usage(e.to_string()),
-        other => store_err(other),
+        other => Error::from(other),
     })?;
     Ok((p, campaign))
 }
@@ -262,15 +256,15 @@ pub(crate) fn done_jobs_of(dir: &Path, filters: &[String]) -> Result<(Vec<String
     let wanted = parse_filters(&store, filters)?;
     let jobs = store.done_jobs_where(id, &wanted).map_err(|e| match e {
         store::StoreError::UnknownParameter { .. } => Error::Usage(e.to_string()),
-        other => store_err(other),
+        other => Error::from(other),
     })?;
     Ok((jobs, campaign))
 }
 
 /// `granflow query --sql`.
 pub fn sql(dir: &Path, query: &str, format: Format) -> Result<String, Error> {
-    let store = Store::open_read_only(database_path(dir)).map_err(store_err)?;
-    let (header, rows) = store.query_sql(query).map_err(store_err)?;
+    let store = Store::open_read_only(database_path(dir))?;
+    let (header, rows) = store.query_sql(query)?;
     Ok(render(&header, &rows, format))
 }
 
@@ -280,7 +274,7 @@ pub fn sql(dir: &Path, query: &str, format: Format) -> Result<String, Error> {
 /// as it is stored: its axis name, or its parameter path when the sweep gives it none.
 pub fn export(dir: &Path, format: Format) -> Result<String, Error> {
     let (store, id, campaign) = open(dir)?;
-    let (header, rows) = store.export_rows(id).map_err(store_err)?;
+    let (header, rows) = store.export_rows(id)?;
     let (header, rows) = in_sweep_order(&campaign, header, rows);
     Ok(render(&header, &rows, format))
 }

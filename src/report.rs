@@ -17,10 +17,6 @@ use crate::error::Error;
 use crate::store::Store;
 use wall_time::WallTime;
 
-fn store_err(e: crate::store::StoreError) -> Error {
-    Error::External(e.to_string())
-}
-
 /// One evaluated check.
 #[derive(Debug, Clone)]
 pub struct CheckResult {
@@ -195,18 +191,15 @@ pub fn report(dir: &Path) -> Result<(String, bool), Error> {
             campaign.spec.name
         )));
     };
-    let store = Store::open_read_only(database_path(dir)).map_err(store_err)?;
+    let store = Store::open_read_only(database_path(dir))?;
     let stored = store
-        .campaign_by_name(&campaign.spec.name)
-        .map_err(store_err)?
+        .campaign_by_name(&campaign.spec.name)?
         .ok_or_else(|| Error::External(format!("{}: no campaign in the database", dir.display())))?;
     let id = stored.id;
-    let (header, rows) = store.export_rows(id).map_err(store_err)?;
-    let (_, derived_rows) = store
-        .query_sql(&format!(
-            "SELECT group_json, name, value, unit FROM derived WHERE campaign_id = {id} ORDER BY group_json, name"
-        ))
-        .map_err(store_err)?;
+    let (header, rows) = store.export_rows(id)?;
+    let (_, derived_rows) = store.query_sql(&format!(
+        "SELECT group_json, name, value, unit FROM derived WHERE campaign_id = {id} ORDER BY group_json, name"
+    ))?;
     let derived: Vec<(String, String, Option<f64>)> = derived_rows
         .iter()
         .map(|r| {
@@ -222,22 +215,18 @@ pub fn report(dir: &Path) -> Result<(String, bool), Error> {
         .iter()
         .map(|c| evaluate(c, &header, &rows, &derived))
         .collect();
-    let (_, timing_rows) = store
-        .query_sql(&format!(
-            "SELECT job_id, sim_time_s FROM jobs WHERE campaign_id = {id} ORDER BY ordinal"
-        ))
-        .map_err(store_err)?;
-    let wall_time = WallTime::of(&store.attempt_spans(id).map_err(store_err)?);
-    let counts = store.status_counts(id).map_err(store_err)?;
+    let (_, timing_rows) = store.query_sql(&format!(
+        "SELECT job_id, sim_time_s FROM jobs WHERE campaign_id = {id} ORDER BY ordinal"
+    ))?;
+    let wall_time = WallTime::of(&store.attempt_spans(id)?);
+    let counts = store.status_counts(id)?;
     // Which builds finished the done jobs (the attempt that ended `done`; NULL before builds were recorded).
-    let (_, build_rows) = store
-        .query_sql(&format!(
-            "SELECT COALESCE(a.build, 'unknown (finished before builds were recorded)'), COUNT(DISTINCT a.job_id)
+    let (_, build_rows) = store.query_sql(&format!(
+        "SELECT COALESCE(a.build, 'unknown (finished before builds were recorded)'), COUNT(DISTINCT a.job_id)
              FROM attempts a JOIN jobs j ON j.job_id = a.job_id
              WHERE j.campaign_id = {id} AND j.status = 'done' AND a.outcome = 'done'
              GROUP BY 1 ORDER BY 2 DESC, 1"
-        ))
-        .map_err(store_err)?;
+    ))?;
     let builds: Vec<(String, i64)> = build_rows
         .iter()
         .map(|r| {

@@ -82,10 +82,6 @@ fn parallel_within_memory(campaign: &Campaign, asked: usize) -> usize {
     fits.min(asked)
 }
 
-fn store_err(e: store::StoreError) -> Error {
-    Error::External(e.to_string())
-}
-
 /// Validates, prepares and runs a campaign in `out` to the end (or until interrupted).
 pub fn run_campaign(campaign: &Campaign, source: &Path, out: &Path, opts: &DispatchOptions) -> Result<Outcome, Error> {
     // Everything that can be wrong with the input is found before anything is written.
@@ -113,20 +109,16 @@ pub fn run_campaign(campaign: &Campaign, source: &Path, out: &Path, opts: &Dispa
     let _log_guard = super::log::init(&campaign_dir::log_path(out));
     tracing::info!(campaign = %campaign.spec.name, jobs = campaign.jobs.len(), "dispatcher started");
 
-    let mut store = Store::open(database_path(out)).map_err(store_err)?;
+    let mut store = Store::open(database_path(out))?;
     let spec_hash = format!("{:016x}", xxhash_rust::xxh3::xxh3_64(campaign.yaml.as_bytes()));
-    let campaign_id = store
-        .upsert_campaign(
-            &campaign.spec.name,
-            &campaign.yaml,
-            &spec_hash,
-            &crate::provenance::build_id(),
-        )
-        .map_err(store_err)?;
+    let campaign_id = store.upsert_campaign(
+        &campaign.spec.name,
+        &campaign.yaml,
+        &spec_hash,
+        &crate::provenance::build_id(),
+    )?;
     if source != copy {
-        store
-            .set_campaign_source(campaign_id, &source.display().to_string())
-            .map_err(store_err)?;
+        store.set_campaign_source(campaign_id, &source.display().to_string())?;
     }
     let new_jobs: Vec<NewJob> = campaign
         .jobs
@@ -143,13 +135,12 @@ pub fn run_campaign(campaign: &Campaign, source: &Path, out: &Path, opts: &Dispa
                 .collect(),
         })
         .collect();
-    store.insert_jobs(campaign_id, &new_jobs).map_err(store_err)?;
-    store.reset_running_to_pending(campaign_id).map_err(store_err)?;
+    store.insert_jobs(campaign_id, &new_jobs)?;
+    store.reset_running_to_pending(campaign_id)?;
 
     // Job directories and results that arrived while no dispatcher was listening.
     let rows: HashMap<String, store::JobRow> = store
-        .job_summaries(campaign_id)
-        .map_err(store_err)?
+        .job_summaries(campaign_id)?
         .into_iter()
         .map(|r| (r.job_id.clone(), r))
         .collect();
@@ -183,7 +174,7 @@ pub fn run_campaign(campaign: &Campaign, source: &Path, out: &Path, opts: &Dispa
         };
         let jobs: HashMap<String, JobSpec> = campaign.jobs.iter().map(|j| (j.job_id.clone(), j.clone())).collect();
         let attempts: HashMap<String, u32> = rows.iter().map(|(id, r)| (id.clone(), r.attempt)).collect();
-        let retries_used = store.retries_used(campaign_id).map_err(store_err)?;
+        let retries_used = store.retries_used(campaign_id)?;
         let quiet = opts.quiet;
         let interrupted = super::slurm::dispatch(
             &mut store,
@@ -207,7 +198,7 @@ pub fn run_campaign(campaign: &Campaign, source: &Path, out: &Path, opts: &Dispa
         return finish(&mut store, campaign, campaign_id, outcome, interrupted);
     };
     // Jobs a Slurm executor submitted are Slurm's until their tasks end: a local run would wait for them forever.
-    let in_slurm = store.slurm_running(campaign_id).map_err(store_err)?;
+    let in_slurm = store.slurm_running(campaign_id)?;
     if let Some((job_id, _, task)) = in_slurm.first() {
         return Err(Error::Usage(format!(
             "{} job(s) of {} are Slurm tasks still followed as running (e.g. {job_id}, task {task}): resume with the \
@@ -235,8 +226,7 @@ pub fn run_campaign(campaign: &Campaign, source: &Path, out: &Path, opts: &Dispa
     };
     let total = campaign.jobs.len();
     let already_done = store
-        .status_counts(campaign_id)
-        .map_err(store_err)?
+        .status_counts(campaign_id)?
         .get(JobStatus::Done.as_str())
         .copied()
         .unwrap_or(0);
@@ -251,7 +241,7 @@ pub fn run_campaign(campaign: &Campaign, source: &Path, out: &Path, opts: &Dispa
         .iter()
         .map(|j| (j.job_id.clone(), campaign.label(j)))
         .collect();
-    let retries_used = store.retries_used(campaign_id).map_err(store_err)?;
+    let retries_used = store.retries_used(campaign_id)?;
     let interrupted = runtime.block_on(dispatch(
         &mut store,
         queue,
@@ -276,7 +266,7 @@ fn finish(
     if !campaign.spec.derived.is_empty() {
         store_derived(store, campaign_id, &campaign.spec.derived)?;
     }
-    let counts = store.status_counts(campaign_id).map_err(store_err)?;
+    let counts = store.status_counts(campaign_id)?;
     let count = |s: JobStatus| counts.get(s.as_str()).copied().unwrap_or(0);
     outcome.done = count(JobStatus::Done);
     outcome.failed = count(JobStatus::Failed);
@@ -297,11 +287,9 @@ pub fn store_derived(
     campaign_id: i64,
     specs: &[crate::campaign::derived::DerivedSpec],
 ) -> Result<(), Error> {
-    let (header, rows) = store.export_rows(campaign_id).map_err(store_err)?;
+    let (header, rows) = store.export_rows(campaign_id)?;
     for d in crate::campaign::derived::compute(specs, &header, &rows) {
-        store
-            .insert_derived(campaign_id, &d.group_json, d.name, d.value, d.unit)
-            .map_err(store_err)?;
+        store.insert_derived(campaign_id, &d.group_json, d.name, d.value, d.unit)?;
     }
     Ok(())
 }
@@ -313,14 +301,13 @@ fn check_no_orphans(campaign: &Campaign, source: &Path, out: &Path) -> Result<()
     if !db.exists() {
         return Ok(());
     }
-    let store = Store::open_read_only(&db).map_err(store_err)?;
-    let Some(stored) = store.campaign_by_name(&campaign.spec.name).map_err(store_err)? else {
+    let store = Store::open_read_only(&db)?;
+    let Some(stored) = store.campaign_by_name(&campaign.spec.name)? else {
         return Ok(());
     };
     let wanted: std::collections::HashSet<&str> = campaign.jobs.iter().map(|j| j.job_id.as_str()).collect();
     let orphans: Vec<String> = store
-        .job_summaries(stored.id)
-        .map_err(store_err)?
+        .job_summaries(stored.id)?
         .into_iter()
         .filter(|r| !wanted.contains(r.job_id.as_str()))
         .map(|r| r.params_json)
@@ -380,7 +367,7 @@ fn store_result(store: &mut Store, job_id: &str, result: &worker::JobResult, fin
         finished_at,
         build: result.build.clone(),
     };
-    store.finish_job(job_id, &stored).map_err(store_err)
+    store.finish_job(job_id, &stored).map_err(Error::from)
 }
 
 /// `granflow reduce <dir>`: recomputes the metrics of every finished job of the campaign in `dir` with this build's
@@ -389,11 +376,10 @@ fn store_result(store: &mut Store, job_id: &str, result: &worker::JobResult, fin
 pub fn reduce_campaign_again(dir: &Path) -> Result<usize, Error> {
     let campaign = campaign_dir::load_stored_campaign(dir)?;
     let _lock = campaign_dir::lock(dir)?;
-    let mut store = Store::open(database_path(dir)).map_err(store_err)?;
+    let mut store = Store::open(database_path(dir))?;
     let campaign_id = campaign_dir::stored_campaign_id(&store, &campaign, dir)?;
     let done: Vec<(String, f64)> = store
-        .job_summaries(campaign_id)
-        .map_err(store_err)?
+        .job_summaries(campaign_id)?
         .into_iter()
         .filter(|j| j.status == JobStatus::Done)
         .map(|j| (j.job_id, j.finished_at.unwrap_or_else(store::unix_time_s)))
@@ -467,15 +453,13 @@ async fn dispatch(
             };
             match spawn(&job, settings, dt_halvings, tx.clone()) {
                 Ok((child_pid, stdin)) => {
-                    store
-                        .mark_running(
-                            &job.job_id,
-                            attempt,
-                            &hostname(),
-                            store::unix_time_s(),
-                            &crate::provenance::build_id(),
-                        )
-                        .map_err(store_err)?;
+                    store.mark_running(
+                        &job.job_id,
+                        attempt,
+                        &hostname(),
+                        store::unix_time_s(),
+                        &crate::provenance::build_id(),
+                    )?;
                     let label = labels.get(&job.job_id).cloned().unwrap_or_default();
                     tracing::info!(job = %job.job_id, attempt, params = %label, "started");
                     progress.started(&job.job_id, &label);
@@ -506,7 +490,7 @@ async fn dispatch(
                     r.last_heard = Instant::now();
                     match m.event {
                         Event::Progress { step, total_steps, time_s, steps_per_s } => {
-                            store.heartbeat(&job_id, time_s, step, store::unix_time_s()).map_err(store_err)?;
+                            store.heartbeat(&job_id, time_s, step, store::unix_time_s())?;
                             progress.progress(&job_id, step, total_steps, time_s, steps_per_s);
                         }
                         Event::Started { step, total_steps, resumed_from_step, .. } => {
@@ -543,7 +527,7 @@ async fn dispatch(
                         None => format!("worker was killed by a signal (see {})", worker_log_path(&dir).display()),
                     });
                     let after = after_failure(&settings.retry, &mut retries_used, &job_id, class);
-                    store.mark_failed(&job_id, r.attempt, class, &error, store::unix_time_s(), after).map_err(store_err)?;
+                    store.mark_failed(&job_id, r.attempt, class, &error, store::unix_time_s(), after)?;
                     tracing::warn!(job = %job_id, class = class.as_str(), error, retry = matches!(after, AfterFailure::Retry), "attempt ended without a result");
                     match after {
                         AfterFailure::Retry if interrupts == 0 => {

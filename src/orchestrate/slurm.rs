@@ -358,11 +358,10 @@ pub fn dispatch(
     let job_name = slurm_job_name(settings.out);
     let host = "slurm";
     let build = crate::provenance::build_id();
-    let err = |e: store::StoreError| Error::External(e.to_string());
 
     // The tasks a previous dispatcher submitted: those Slurm still has are followed, the others have ended.
     let mut following: Vec<Followed> = Vec::new();
-    for (job_id, attempt, task) in store.slurm_running(settings.campaign_id).map_err(err)? {
+    for (job_id, attempt, task) in store.slurm_running(settings.campaign_id)? {
         let Some(job) = jobs.get(&job_id) else { continue };
         following.push(Followed {
             job: job.clone(),
@@ -399,10 +398,8 @@ pub fn dispatch(
             let job = queue.remove(position).expect("the position is in the queue");
             let attempt = attempts.get(&job_id).copied().unwrap_or(0) + 1;
             attempts.insert(job_id.clone(), attempt);
-            store
-                .mark_running(&job_id, attempt, host, store::unix_time_s(), &build)
-                .map_err(err)?;
-            store.set_slurm_task(&job_id, task, "UNKNOWN").map_err(err)?;
+            store.mark_running(&job_id, attempt, host, store::unix_time_s(), &build)?;
+            store.set_slurm_task(&job_id, task, "UNKNOWN")?;
             tracing::info!(job = %job_id, task, "found in Slurm's queue: following it");
             following.push(Followed {
                 ends_seen: task_ends(&job_dir(settings.out, &job_id)).len(),
@@ -425,10 +422,8 @@ pub fn dispatch(
                 for (job, task) in batch.into_iter().zip(tasks) {
                     let attempt = attempts.get(&job.job_id).copied().unwrap_or(0) + 1;
                     attempts.insert(job.job_id.clone(), attempt);
-                    store
-                        .mark_running(&job.job_id, attempt, host, store::unix_time_s(), &build)
-                        .map_err(err)?;
-                    store.set_slurm_task(&job.job_id, &task, "SUBMITTED").map_err(err)?;
+                    store.mark_running(&job.job_id, attempt, host, store::unix_time_s(), &build)?;
+                    store.set_slurm_task(&job.job_id, &task, "SUBMITTED")?;
                     tracing::info!(job = %job.job_id, attempt, task, "submitted");
                     on_event(&format!("submitted {} as Slurm task {task}", job.job_id));
                     following.push(Followed {
@@ -476,20 +471,16 @@ pub fn dispatch(
             for end in ends.iter().skip(f.ends_seen).filter(|e| e.task == f.task) {
                 if end.exit == EXIT_PREEMPTED && queued.contains_key(&f.task) {
                     let error = format!("preempted: task {} checkpointed on Slurm's signal and requeued", f.task);
-                    store
-                        .mark_failed(
-                            &f.job.job_id,
-                            f.attempt,
-                            FailureClass::Preempted,
-                            &error,
-                            store::unix_time_s(),
-                            AfterFailure::Retry,
-                        )
-                        .map_err(err)?;
-                    store
-                        .mark_running(&f.job.job_id, f.attempt, host, store::unix_time_s(), &build)
-                        .map_err(err)?;
-                    store.set_slurm_task(&f.job.job_id, &f.task, "REQUEUED").map_err(err)?;
+                    store.mark_failed(
+                        &f.job.job_id,
+                        f.attempt,
+                        FailureClass::Preempted,
+                        &error,
+                        store::unix_time_s(),
+                        AfterFailure::Retry,
+                    )?;
+                    store.mark_running(&f.job.job_id, f.attempt, host, store::unix_time_s(), &build)?;
+                    store.set_slurm_task(&f.job.job_id, &f.task, "REQUEUED")?;
                     tracing::info!(job = %f.job.job_id, task = %f.task, "preempted and requeued");
                     on_event(&format!("{} preempted; task {} requeued", f.job.job_id, f.task));
                 }
@@ -497,19 +488,17 @@ pub fn dispatch(
             f.ends_seen = ends.len();
             if let Some((state, _)) = queued.get(&f.task) {
                 if *state != f.state {
-                    store.set_slurm_state(&f.job.job_id, state).map_err(err)?;
+                    store.set_slurm_state(&f.job.job_id, state)?;
                     f.state = state.clone();
                 }
                 if let Some((step, time_s)) = last_progress(&dir) {
-                    store
-                        .heartbeat(&f.job.job_id, time_s, step, store::unix_time_s())
-                        .map_err(err)?;
+                    store.heartbeat(&f.job.job_id, time_s, step, store::unix_time_s())?;
                 }
                 still.push(f);
                 continue;
             }
             // The task has left the queue.
-            store.set_slurm_state(&f.job.job_id, "ENDED").map_err(err)?;
+            store.set_slurm_state(&f.job.job_id, "ENDED")?;
             match worker::read_result(&dir) {
                 Ok(Some(result)) => {
                     super::dispatcher::ingest(store, &f.job.job_id, &result)?;
@@ -546,9 +535,7 @@ pub fn dispatch(
                 ),
             };
             let after = super::dispatcher::after_failure(settings.retry, &mut retries_used, &f.job.job_id, class);
-            store
-                .mark_failed(&f.job.job_id, f.attempt, class, &error, store::unix_time_s(), after)
-                .map_err(err)?;
+            store.mark_failed(&f.job.job_id, f.attempt, class, &error, store::unix_time_s(), after)?;
             tracing::warn!(job = %f.job.job_id, class = class.as_str(), error, "task ended without a result");
             match after {
                 AfterFailure::Retry => queue.push_back(f.job),
